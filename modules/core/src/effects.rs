@@ -1,0 +1,39 @@
+//! Light-transport features a scene calls for.
+//!
+//! Every module instance declares the [`Effects`] it needs; the engine's
+//! extract step unions them into the scene's effect set and compiles only the
+//! integrator paths those effects require.
+
+use bitflags::bitflags;
+
+bitflags! {
+    /// A set of light-transport features.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+    pub struct Effects: u32 {
+        /// Emitters on surfaces that rays can hit (area lights).
+        const AREA_LIGHTS = 1 << 0;
+        /// Lights with a delta distribution (point, spot, directional).
+        const DELTA_LIGHTS = 1 << 1;
+        /// Light arriving from infinitely far away (environment maps).
+        const ENVIRONMENT = 1 << 2;
+        /// Textures that vary over a surface (anything but constants).
+        const TEXTURES = 1 << 3;
+        /// Smooth (non-delta) reflection lobes: diffuse or glossy.
+        const SMOOTH_LOBES = 1 << 4;
+        /// Glossy (microfacet) lobes.
+        const GLOSSY = 1 << 5;
+        /// Perfectly specular (delta) lobes.
+        const DELTA_LOBES = 1 << 6;
+        /// Transmission through surfaces.
+        const TRANSMISSION = 1 << 7;
+        /// A camera with a finite aperture.
+        const DEPTH_OF_FIELD = 1 << 8;
+    }
+}
+
+impl Effects {
+    /// Human-readable names of the effects in this set, in declaration order.
+    pub fn names(self) -> Vec<&'static str> {
+        self.iter_names().map(|(name, _)| name).collect()
+    }
+}

@@ -1,0 +1,48 @@
+//! # radiant-core: the module contract
+//!
+//! Radiant's engine and its plugin modules meet in this crate. It defines
+//!
+//! * one trait per module kind — [`Camera`], [`Light`], [`Filter`], [`Shader`],
+//!   [`Sampler`], [`Texture`] — whose hot methods take *batches* (slices), so
+//!   dynamic dispatch happens once per batch and the inner loops are plain code;
+//! * the [`Registry`] through which built-in and outside modules are made
+//!   known by their YAML `type` name, and [`Params`], the YAML parameters a
+//!   module parses for itself with serde;
+//! * the [`Effects`] a module declares, from which the engine decides which
+//!   light-transport features a scene needs;
+//! * the small shared maths every module uses: [`Frame`], sampling warps in
+//!   [`warp`], stateless hashing in [`hash`].
+//!
+//! Data flow: the engine parses a scene, looks up each `type` in the
+//! [`Registry`], hands the module its [`Params`] and a [`BuildContext`], and
+//! gets back a boxed trait object that it calls once per batch while rendering.
+
+pub mod build;
+pub mod camera;
+pub mod color;
+pub mod effects;
+pub mod filter;
+pub mod frame;
+pub mod hash;
+pub mod light;
+pub mod params;
+pub mod registry;
+pub mod sampler;
+pub mod shader;
+pub mod texture;
+pub mod warp;
+
+pub use build::{BuildContext, EmitterShape};
+pub use camera::{Camera, CameraRays};
+pub use color::{Rgb, luminance};
+pub use effects::Effects;
+pub use filter::Filter;
+pub use frame::Frame;
+pub use light::{EmitterEval, EmitterHit, Light, LightSample};
+pub use params::{ParamError, Params, TextureInput};
+pub use registry::{ModuleInfo, ModuleKind, ParamDoc, Registry};
+pub use sampler::{SampleId, Sampler};
+pub use shader::{BsdfEval, BsdfSample, ShadeContext, Shader, SurfaceBatch};
+pub use texture::{Texture, TextureId, TextureTable};
+
+pub use glam;

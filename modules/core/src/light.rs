@@ -1,0 +1,72 @@
+//! Lights: next-event estimation samples and emitted radiance at hits.
+//!
+//! The engine picks a light per path vertex (in proportion to
+//! [`Light::power`]), groups the vertices by light and calls
+//! [`Light::sample`] once per group. Rays that hit an emissive surface are
+//! likewise grouped and passed to [`Light::eval_hits`], which returns the
+//! emitted radiance and the density with which `sample` would have produced
+//! that point, for multiple importance sampling.
+
+use crate::{Effects, Rgb};
+use glam::{Vec2, Vec3};
+
+/// One light sample as seen from a reference point.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LightSample {
+    /// The sampled point on the light, in render space.
+    pub p: Vec3,
+    /// Unit surface normal at `p` (zero for point-like lights).
+    pub n: Vec3,
+    /// Radiance arriving at the reference point from `p`, before division by
+    /// `pdf` (for delta lights: intensity / distance²).
+    pub radiance: Rgb,
+    /// Density of `p` in solid angle at the reference point (1 for delta
+    /// lights; 0 marks a failed sample).
+    pub pdf: f32,
+}
+
+/// A ray that hit a surface emitter, as handed to [`Light::eval_hits`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct EmitterHit {
+    /// Where the ray started (the previous path vertex).
+    pub origin: Vec3,
+    /// The hit point.
+    pub p: Vec3,
+    /// Unit geometric normal at the hit point.
+    pub n: Vec3,
+    /// Index of the hit primitive within the emitter's [`EmitterShape`](crate::EmitterShape).
+    pub primitive: u32,
+}
+
+/// The answer of [`Light::eval_hits`] for one hit.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct EmitterEval {
+    /// Radiance emitted from the hit point towards the ray origin.
+    pub radiance: Rgb,
+    /// Density in solid angle with which [`Light::sample`] picks this point
+    /// from the ray origin.
+    pub pdf: f32,
+}
+
+/// A light module.
+pub trait Light: Send + Sync {
+    /// Total emitted power (a scalar proxy, e.g. luminance × area × π for a
+    /// diffuse area light); light selection is proportional to it.
+    fn power(&self) -> f32;
+
+    /// Whether the light's emission is a delta distribution (cannot be hit).
+    fn is_delta(&self) -> bool;
+
+    /// Samples a point on the light for each reference point `refs[i]` with
+    /// the 2D sample `u[i]`.
+    fn sample(&self, refs: &[Vec3], u: &[Vec2], out: &mut [LightSample]);
+
+    /// Evaluates emission for rays that hit this light's surface. Lights
+    /// without surfaces are never hit, so the default writes nothing.
+    fn eval_hits(&self, hits: &[EmitterHit], out: &mut [EmitterEval]) {
+        out[..hits.len()].fill(EmitterEval::default());
+    }
+
+    /// Effects this light needs.
+    fn effects(&self) -> Effects;
+}

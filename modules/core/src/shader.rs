@@ -1,0 +1,118 @@
+//! Shaders (BSDFs): sampling and evaluation of scattering at surfaces.
+//!
+//! All directions are in the local shading frame: +z is the shading normal,
+//! `wo` points towards where light goes (the previous vertex), `wi` towards
+//! where it comes from. Values include the cosine foreshortening factor
+//! |cos θi|, so a path's throughput is multiplied by `weight` directly.
+
+use crate::{Effects, Rgb, TextureId, TextureTable};
+use glam::{Vec2, Vec3};
+
+/// The surface points of one shading batch.
+#[derive(Clone, Copy)]
+pub struct SurfaceBatch<'a> {
+    /// Outgoing directions, local frame, unit length.
+    pub wo: &'a [Vec3],
+    /// Surface texture coordinates.
+    pub uv: &'a [Vec2],
+}
+
+impl SurfaceBatch<'_> {
+    /// Number of surface points in the batch.
+    pub fn len(&self) -> usize {
+        self.wo.len()
+    }
+
+    /// Whether the batch is empty.
+    pub fn is_empty(&self) -> bool {
+        self.wo.is_empty()
+    }
+}
+
+/// The result of sampling a BSDF.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BsdfSample {
+    /// The sampled incident direction, local frame.
+    pub wi: Vec3,
+    /// f · |cos θi| / pdf; zero marks a failed sample.
+    pub weight: Rgb,
+    /// Solid-angle density of `wi` (for delta lobes: the lobe's selection
+    /// probability, and `delta` is set).
+    pub pdf: f32,
+    /// Whether `wi` came from a delta (perfectly specular) lobe.
+    pub delta: bool,
+}
+
+/// The result of evaluating a BSDF for a given pair of directions.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BsdfEval {
+    /// f · |cos θi|.
+    pub value: Rgb,
+    /// Solid-angle density with which `sample` would produce `wi`.
+    pub pdf: f32,
+}
+
+/// Per-thread state a shader may use while shading a batch: the scene's
+/// textures and reusable scratch buffers (so no per-ray allocation).
+pub struct ShadeContext<'a> {
+    textures: &'a TextureTable,
+    scratch: [Vec<Rgb>; 4],
+}
+
+impl<'a> ShadeContext<'a> {
+    /// Creates a context over the scene's textures.
+    pub fn new(textures: &'a TextureTable) -> Self {
+        Self {
+            textures,
+            scratch: Default::default(),
+        }
+    }
+
+    /// The scene's textures.
+    pub fn textures(&self) -> &'a TextureTable {
+        self.textures
+    }
+
+    /// Evaluates up to four textures at the batch's texture coordinates and
+    /// returns their values, one slice per texture.
+    pub fn lookup<const N: usize>(&mut self, ids: [TextureId; N], uv: &[Vec2]) -> [&[Rgb]; N] {
+        const { assert!(N <= 4, "at most four textures per lookup") };
+        let textures = self.textures;
+        let mut bufs = self.scratch.iter_mut();
+        ids.map(|id| {
+            let buf = bufs.next().expect("N <= 4");
+            if buf.len() < uv.len() {
+                buf.resize(uv.len(), Rgb::ZERO);
+            }
+            textures.eval(id, uv, buf);
+            &buf[..uv.len()]
+        })
+    }
+}
+
+/// A shader module (a BSDF).
+pub trait Shader: Send + Sync {
+    /// Samples an incident direction for each surface point, using the
+    /// samples `u[i]` (a 1D value in `x` for lobe selection, a 2D value in
+    /// `y`, `z`).
+    fn sample(
+        &self,
+        ctx: &mut ShadeContext<'_>,
+        surface: SurfaceBatch<'_>,
+        u: &[Vec3],
+        out: &mut [BsdfSample],
+    );
+
+    /// Evaluates the BSDF for each surface point and incident direction
+    /// `wi[i]` (local frame).
+    fn eval(
+        &self,
+        ctx: &mut ShadeContext<'_>,
+        surface: SurfaceBatch<'_>,
+        wi: &[Vec3],
+        out: &mut [BsdfEval],
+    );
+
+    /// Effects this shader needs (its lobes, its textures).
+    fn effects(&self) -> Effects;
+}

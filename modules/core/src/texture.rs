@@ -1,0 +1,103 @@
+//! Textures: functions of surface (u, v) that shaders read in batches.
+//!
+//! Scenes reference textures by name or give a value inline; inline values
+//! become constant entries of the [`TextureTable`] and are looked up without
+//! any dynamic dispatch.
+
+use crate::{Effects, Rgb};
+use glam::Vec2;
+
+/// A texture module: evaluates colours for a batch of (u, v) coordinates.
+pub trait Texture: Send + Sync {
+    /// Writes the texture's value at `uv[i]` into `out[i]`.
+    fn eval(&self, uv: &[Vec2], out: &mut [Rgb]);
+
+    /// The single value of a texture that does not vary, if it is one.
+    fn constant(&self) -> Option<Rgb> {
+        None
+    }
+
+    /// The mean value over the unit square, used for power estimates.
+    fn mean(&self) -> Rgb;
+
+    /// Effects this texture needs.
+    fn effects(&self) -> Effects {
+        Effects::TEXTURES
+    }
+}
+
+/// Index of a texture in the scene's [`TextureTable`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct TextureId(pub u32);
+
+enum Entry {
+    Constant(Rgb),
+    Module(Box<dyn Texture>),
+}
+
+/// All textures of a scene.
+#[derive(Default)]
+pub struct TextureTable {
+    entries: Vec<Entry>,
+}
+
+impl TextureTable {
+    /// Adds an inline constant value and returns its id.
+    pub fn add_constant(&mut self, value: Rgb) -> TextureId {
+        self.entries.push(Entry::Constant(value));
+        TextureId(self.entries.len() as u32 - 1)
+    }
+
+    /// Adds a texture module instance and returns its id.
+    pub fn add(&mut self, texture: Box<dyn Texture>) -> TextureId {
+        let entry = match texture.constant() {
+            Some(c) => Entry::Constant(c),
+            None => Entry::Module(texture),
+        };
+        self.entries.push(entry);
+        TextureId(self.entries.len() as u32 - 1)
+    }
+
+    /// Evaluates texture `id` at every `uv[i]` into `out[i]`.
+    #[inline]
+    pub fn eval(&self, id: TextureId, uv: &[Vec2], out: &mut [Rgb]) {
+        match &self.entries[id.0 as usize] {
+            Entry::Constant(c) => out[..uv.len()].fill(*c),
+            Entry::Module(t) => t.eval(uv, &mut out[..uv.len()]),
+        }
+    }
+
+    /// The constant value of texture `id`, if it does not vary.
+    pub fn constant(&self, id: TextureId) -> Option<Rgb> {
+        match &self.entries[id.0 as usize] {
+            Entry::Constant(c) => Some(*c),
+            Entry::Module(_) => None,
+        }
+    }
+
+    /// The mean value of texture `id` over the unit square.
+    pub fn mean(&self, id: TextureId) -> Rgb {
+        match &self.entries[id.0 as usize] {
+            Entry::Constant(c) => *c,
+            Entry::Module(t) => t.mean(),
+        }
+    }
+
+    /// Effects needed by texture `id`.
+    pub fn effects(&self, id: TextureId) -> Effects {
+        match &self.entries[id.0 as usize] {
+            Entry::Constant(_) => Effects::empty(),
+            Entry::Module(t) => t.effects(),
+        }
+    }
+
+    /// Number of textures, constants included.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// Whether the table holds no texture.
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+}
