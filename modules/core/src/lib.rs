@@ -39,7 +39,7 @@ pub use effects::Effects;
 pub use filter::Filter;
 pub use frame::Frame;
 pub use light::{EmitterEval, EmitterHit, Light, LightSample};
-pub use params::{ParamError, Params, TextureInput};
+pub use params::{Color, ParamError, Params, TextureInput};
 pub use registry::{ModuleInfo, ModuleKind, ParamDoc, Registry};
 pub use sampler::{SampleId, Sampler};
 pub use shader::{BsdfEval, BsdfSample, ShadeContext, Shader, SurfaceBatch};

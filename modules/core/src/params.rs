@@ -175,6 +175,45 @@ impl<'de> Deserialize<'de> for TextureInput {
     }
 }
 
+/// A constant colour parameter: `0.5` or `[0.8, 0.2, 0.1]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Color(pub Rgb);
+
+impl<'de> Deserialize<'de> for Color {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        match TextureInput::deserialize(deserializer)? {
+            TextureInput::Value(v) => Ok(Color(v)),
+            TextureInput::Named(name) => Err(de::Error::custom(format!(
+                "expected a number or an [r, g, b] list, found `{name}`"
+            ))),
+        }
+    }
+}
+
+/// Checks that the documented parameters `docs` are exactly the fields that
+/// `T` accepts (for modules' own tests: `radiant modules` must not lie).
+///
+/// `T` must deny unknown fields.
+pub fn check_param_docs<T: DeserializeOwned>(docs: &[crate::ParamDoc]) -> Result<(), String> {
+    let probe = Params::from_yaml("__probe__: 0\n").map_err(|e| e.to_string())?;
+    let err = match marked_yaml::from_node::<T>(probe.node()) {
+        Ok(_) => return Err("the parameter type accepts unknown fields".into()),
+        Err(e) => e.into_inner(),
+    };
+    let marked_yaml::Error::UnknownFieldError(_, fields, _) = err else {
+        return Err(format!("expected an unknown-field error, got: {err}"));
+    };
+    let mut accepted: Vec<&str> = fields.to_vec();
+    let mut documented: Vec<&str> = docs.iter().map(|d| d.name).collect();
+    accepted.sort_unstable();
+    documented.sort_unstable();
+    if accepted == documented {
+        Ok(())
+    } else {
+        Err(format!("accepted fields {accepted:?} differ from documented {documented:?}"))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

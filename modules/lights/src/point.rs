@@ -1,0 +1,105 @@
+//! The `point` light: an isotropic point source.
+
+use radiant_core::glam::{DVec3, Vec2, Vec3};
+use radiant_core::{
+    Color, Effects, Light, LightSample, ModuleInfo, ParamDoc, Params, Registry, Rgb, luminance,
+};
+use serde::Deserialize;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PointParams {
+    position: [f64; 3],
+    intensity: Color,
+}
+
+const DOCS: &[ParamDoc] = &[
+    ParamDoc {
+        name: "position",
+        ty: "[x, y, z], world space",
+        default: "required",
+        doc: "Where the light is.",
+    },
+    ParamDoc {
+        name: "intensity",
+        ty: "rgb, W/sr",
+        default: "required",
+        doc: "Radiant intensity, the same in every direction.",
+    },
+];
+
+/// An isotropic point light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointLight {
+    position: Vec3,
+    intensity: Rgb,
+}
+
+impl PointLight {
+    /// A point light at `position` (render space) with `intensity`.
+    pub fn new(position: Vec3, intensity: Rgb) -> Self {
+        Self { position, intensity }
+    }
+}
+
+impl Light for PointLight {
+    fn power(&self) -> f32 {
+        4.0 * std::f32::consts::PI * luminance(self.intensity)
+    }
+
+    fn is_delta(&self) -> bool {
+        true
+    }
+
+    fn sample(&self, refs: &[Vec3], _u: &[Vec2], out: &mut [LightSample]) {
+        for (r, o) in refs.iter().zip(out.iter_mut()) {
+            let dist2 = (self.position - *r).length_squared();
+            *o = LightSample {
+                p: self.position,
+                n: Vec3::ZERO,
+                radiance: if dist2 > 0.0 { self.intensity / dist2 } else { Rgb::ZERO },
+                pdf: 1.0,
+            };
+        }
+    }
+
+    fn effects(&self) -> Effects {
+        Effects::DELTA_LIGHTS
+    }
+}
+
+pub(crate) fn register(registry: &mut Registry) {
+    registry.register::<dyn Light>(
+        ModuleInfo {
+            type_name: "point",
+            summary: "Isotropic point light.",
+            params: DOCS,
+        },
+        |params: &Params, ctx| {
+            let p: PointParams = params.parse()?;
+            let position = ctx.to_render(DVec3::from_array(p.position));
+            Ok(Box::new(PointLight::new(position, p.intensity.0)) as Box<dyn Light>)
+        },
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use radiant_core::params::check_param_docs;
+
+    #[test]
+    fn documented_parameters_match() {
+        check_param_docs::<PointParams>(DOCS).unwrap();
+    }
+
+    #[test]
+    fn falls_off_with_the_square_of_distance() {
+        let light = PointLight::new(Vec3::new(0.0, 2.0, 0.0), Rgb::splat(8.0));
+        let mut out = [LightSample::default(); 2];
+        light.sample(&[Vec3::ZERO, Vec3::new(0.0, -2.0, 0.0)], &[Vec2::ZERO; 2], &mut out);
+        assert_eq!(out[0].radiance, Rgb::splat(2.0));
+        assert_eq!(out[1].radiance, Rgb::splat(0.5));
+        assert!(light.is_delta());
+    }
+}

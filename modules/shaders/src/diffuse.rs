@@ -1,0 +1,170 @@
+//! The `diffuse` shader: an ideal one-sided Lambertian reflector.
+
+use radiant_core::glam::{Vec2, Vec3};
+use radiant_core::params::Spanned;
+use radiant_core::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
+use radiant_core::{
+    BsdfEval, BsdfSample, Effects, ModuleInfo, ParamDoc, Params, Registry, Rgb, ShadeContext,
+    Shader, SurfaceBatch, TextureId, TextureInput,
+};
+use serde::Deserialize;
+use std::f32::consts::FRAC_1_PI;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DiffuseParams {
+    #[serde(default = "default_reflectance")]
+    reflectance: Spanned<TextureInput>,
+}
+
+fn default_reflectance() -> Spanned<TextureInput> {
+    TextureInput::spanned_value(Rgb::splat(0.5))
+}
+
+const DOCS: &[ParamDoc] = &[ParamDoc {
+    name: "reflectance",
+    ty: "rgb | number | texture name, [0, 1]",
+    default: "0.5",
+    doc: "Albedo: the fraction of light reflected.",
+}];
+
+/// Lambertian reflection from the front side (Mitsuba 3's `diffuse`): light
+/// arriving from or leaving towards the back side is absorbed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Diffuse {
+    reflectance: TextureId,
+    effects: Effects,
+}
+
+impl Diffuse {
+    /// A diffuse shader whose albedo is the texture `reflectance`.
+    pub fn new(reflectance: TextureId, texture_effects: Effects) -> Self {
+        Self {
+            reflectance,
+            effects: Effects::SMOOTH_LOBES | texture_effects,
+        }
+    }
+}
+
+impl Shader for Diffuse {
+    fn sample(
+        &self,
+        ctx: &mut ShadeContext<'_>,
+        surface: SurfaceBatch<'_>,
+        u: &[Vec3],
+        out: &mut [BsdfSample],
+    ) {
+        let [albedo] = ctx.lookup([self.reflectance], surface.uv);
+        for (((wo, u), a), o) in surface.wo.iter().zip(u).zip(albedo).zip(out.iter_mut()) {
+            let wi = square_to_cosine_hemisphere(Vec2::new(u.y, u.z));
+            let pdf = cosine_hemisphere_pdf(wi);
+            *o = if wo.z > 0.0 && pdf > 0.0 {
+                BsdfSample {
+                    wi,
+                    weight: *a,
+                    pdf,
+                    delta: false,
+                }
+            } else {
+                BsdfSample::default()
+            };
+        }
+    }
+
+    fn eval(
+        &self,
+        ctx: &mut ShadeContext<'_>,
+        surface: SurfaceBatch<'_>,
+        wi: &[Vec3],
+        out: &mut [BsdfEval],
+    ) {
+        let [albedo] = ctx.lookup([self.reflectance], surface.uv);
+        for (((wo, wi), a), o) in surface.wo.iter().zip(wi).zip(albedo).zip(out.iter_mut()) {
+            *o = if wo.z > 0.0 && wi.z > 0.0 {
+                BsdfEval {
+                    value: *a * (FRAC_1_PI * wi.z),
+                    pdf: cosine_hemisphere_pdf(*wi),
+                }
+            } else {
+                BsdfEval::default()
+            };
+        }
+    }
+
+    fn effects(&self) -> Effects {
+        self.effects
+    }
+}
+
+pub(crate) fn register(registry: &mut Registry) {
+    registry.register::<dyn Shader>(
+        ModuleInfo {
+            type_name: "diffuse",
+            summary: "Ideal one-sided Lambertian reflector.",
+            params: DOCS,
+        },
+        |params: &Params, ctx| {
+            let p: DiffuseParams = params.parse()?;
+            let reflectance = ctx.texture(&p.reflectance)?;
+            let effects = ctx.textures.effects(reflectance);
+            Ok(Box::new(Diffuse::new(reflectance, effects)) as Box<dyn Shader>)
+        },
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use radiant_core::TextureTable;
+    use radiant_core::params::check_param_docs;
+
+    #[test]
+    fn documented_parameters_match() {
+        check_param_docs::<DiffuseParams>(DOCS).unwrap();
+    }
+
+    #[test]
+    fn sample_weight_matches_eval_over_pdf_and_furnace_is_one() {
+        let mut textures = TextureTable::default();
+        let white = textures.add_constant(Rgb::ONE);
+        let shader = Diffuse::new(white, Effects::empty());
+        let mut ctx = ShadeContext::new(&textures);
+        let n = 64usize;
+        let wo = vec![Vec3::new(0.6, 0.0, 0.8); n * n];
+        let uv = vec![Vec2::ZERO; n * n];
+        let u: Vec<Vec3> = (0..n * n)
+            .map(|i| Vec3::new(0.5, ((i % n) as f32 + 0.5) / n as f32, ((i / n) as f32 + 0.5) / n as f32))
+            .collect();
+        let surface = SurfaceBatch { wo: &wo, uv: &uv };
+        let mut samples = vec![BsdfSample::default(); n * n];
+        shader.sample(&mut ctx, surface, &u, &mut samples);
+        let wi: Vec<Vec3> = samples.iter().map(|s| s.wi).collect();
+        let mut evals = vec![BsdfEval::default(); n * n];
+        shader.eval(&mut ctx, surface, &wi, &mut evals);
+        let mut mean = 0.0f64;
+        for (s, e) in samples.iter().zip(&evals) {
+            if s.pdf > 0.0 {
+                assert!((e.value / e.pdf - s.weight).abs().max_element() < 1e-4);
+                assert!((e.pdf - s.pdf).abs() < 1e-5);
+            }
+            mean += s.weight.x as f64;
+        }
+        mean /= (n * n) as f64;
+        assert!((mean - 1.0).abs() < 1e-3, "white furnace: {mean}");
+    }
+
+    #[test]
+    fn back_side_is_black() {
+        let mut textures = TextureTable::default();
+        let white = textures.add_constant(Rgb::ONE);
+        let shader = Diffuse::new(white, Effects::empty());
+        let mut ctx = ShadeContext::new(&textures);
+        let surface = SurfaceBatch { wo: &[Vec3::new(0.0, 0.0, -1.0)], uv: &[Vec2::ZERO] };
+        let mut e = [BsdfEval::default()];
+        shader.eval(&mut ctx, surface, &[Vec3::Z], &mut e);
+        assert_eq!(e[0].value, Rgb::ZERO);
+        let mut s = [BsdfSample::default()];
+        shader.sample(&mut ctx, surface, &[Vec3::splat(0.3)], &mut s);
+        assert_eq!(s[0].weight, Rgb::ZERO);
+    }
+}
