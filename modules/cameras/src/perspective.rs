@@ -168,9 +168,13 @@ mod tests {
 
     #[test]
     fn centre_ray_looks_forward_and_corners_match_fov() {
-        let cam = Perspective::new(Mat4::IDENTITY, Vec2::new(200.0, 100.0), 90.0, FovAxis::X)
-            .unwrap();
-        let film = [Vec2::new(100.0, 50.0), Vec2::new(0.0, 50.0), Vec2::new(100.0, 0.0)];
+        let cam =
+            Perspective::new(Mat4::IDENTITY, Vec2::new(200.0, 100.0), 90.0, FovAxis::X).unwrap();
+        let film = [
+            Vec2::new(100.0, 50.0),
+            Vec2::new(0.0, 50.0),
+            Vec2::new(100.0, 0.0),
+        ];
         let (mut o, mut d, mut w) = ([Vec3::ZERO; 3], [Vec3::ZERO; 3], [0.0; 3]);
         cam.generate(
             &film,

@@ -5,8 +5,8 @@
 //! engine can report `scene.yaml:12:5: …`.
 
 use marked_yaml::{Node, Span};
-use serde::de::{self, DeserializeOwned, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
+use serde::de::{self, DeserializeOwned, Deserializer, SeqAccess, Visitor};
 use std::fmt;
 
 pub use marked_yaml::Spanned;
@@ -210,7 +210,9 @@ pub fn check_param_docs<T: DeserializeOwned>(docs: &[crate::ParamDoc]) -> Result
     if accepted == documented {
         Ok(())
     } else {
-        Err(format!("accepted fields {accepted:?} differ from documented {documented:?}"))
+        Err(format!(
+            "accepted fields {accepted:?} differ from documented {documented:?}"
+        ))
     }
 }
 

@@ -88,7 +88,10 @@ mod tests {
             }
         }
         let est = sum / (n * n) as f64;
-        assert!((est - 2.0 * std::f64::consts::PI / 3.0).abs() < 1e-3, "{est}");
+        assert!(
+            (est - 2.0 * std::f64::consts::PI / 3.0).abs() < 1e-3,
+            "{est}"
+        );
     }
 
     #[test]

@@ -3,7 +3,7 @@
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::warp::{square_to_uniform_sphere, square_to_uniform_triangle};
 use radiant_core::{
-    Color, EmitterEval, EmitterHit, EmitterShape, Effects, Light, LightSample, ModuleInfo,
+    Color, Effects, EmitterEval, EmitterHit, EmitterShape, Light, LightSample, ModuleInfo,
     ParamDoc, ParamError, Params, Registry, Rgb, luminance,
 };
 use serde::Deserialize;
@@ -61,10 +61,17 @@ impl AreaLight {
     #[inline]
     fn pick(&self, u: f32) -> (usize, f32) {
         let target = u * self.area;
-        let i = self.cdf.partition_point(|&c| c <= target).min(self.cdf.len() - 1);
+        let i = self
+            .cdf
+            .partition_point(|&c| c <= target)
+            .min(self.cdf.len() - 1);
         let lo = if i == 0 { 0.0 } else { self.cdf[i - 1] };
         let width = self.cdf[i] - lo;
-        let rescaled = if width > 0.0 { ((target - lo) / width).clamp(0.0, 0.999_999_94) } else { 0.0 };
+        let rescaled = if width > 0.0 {
+            ((target - lo) / width).clamp(0.0, 0.999_999_94)
+        } else {
+            0.0
+        };
         (i, rescaled)
     }
 
@@ -196,7 +203,12 @@ mod tests {
         light.sample(&refs, &u, &mut out);
         for (s, r) in out.iter().zip(&refs) {
             assert!(s.pdf > 0.0 && s.p.z == 0.0 && (0.0..=1.0).contains(&s.p.x));
-            let hit = EmitterHit { origin: *r, p: s.p, n: s.n, primitive: 0 };
+            let hit = EmitterHit {
+                origin: *r,
+                p: s.p,
+                n: s.n,
+                primitive: 0,
+            };
             let mut e = [EmitterEval::default()];
             light.eval_hits(&[hit], &mut e);
             assert!((e[0].pdf - s.pdf).abs() < 1e-4 * s.pdf);
@@ -222,7 +234,10 @@ mod tests {
         let n = 400;
         let mut sum = 0.0f64;
         for i in 0..n * n {
-            let u = Vec2::new(((i % n) as f32 + 0.5) / n as f32, ((i / n) as f32 + 0.5) / n as f32);
+            let u = Vec2::new(
+                ((i % n) as f32 + 0.5) / n as f32,
+                ((i / n) as f32 + 0.5) / n as f32,
+            );
             // Uniform directions over the lower hemisphere: density 1/2π.
             let mut d = square_to_uniform_sphere(u);
             d.z = -d.z.abs();
@@ -235,7 +250,15 @@ mod tests {
                 continue;
             }
             let mut e = [EmitterEval::default()];
-            light.eval_hits(&[EmitterHit { origin, p, n: Vec3::Z, primitive: 0 }], &mut e);
+            light.eval_hits(
+                &[EmitterHit {
+                    origin,
+                    p,
+                    n: Vec3::Z,
+                    primitive: 0,
+                }],
+                &mut e,
+            );
             sum += e[0].pdf as f64 * 2.0 * std::f64::consts::PI / (n * n) as f64;
         }
         assert!((sum - 1.0).abs() < 0.02, "∫pdf = {sum}");

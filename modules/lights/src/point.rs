@@ -38,7 +38,10 @@ pub struct PointLight {
 impl PointLight {
     /// A point light at `position` (render space) with `intensity`.
     pub fn new(position: Vec3, intensity: Rgb) -> Self {
-        Self { position, intensity }
+        Self {
+            position,
+            intensity,
+        }
     }
 }
 
@@ -57,7 +60,11 @@ impl Light for PointLight {
             *o = LightSample {
                 p: self.position,
                 n: Vec3::ZERO,
-                radiance: if dist2 > 0.0 { self.intensity / dist2 } else { Rgb::ZERO },
+                radiance: if dist2 > 0.0 {
+                    self.intensity / dist2
+                } else {
+                    Rgb::ZERO
+                },
                 pdf: 1.0,
             };
         }
@@ -97,7 +104,11 @@ mod tests {
     fn falls_off_with_the_square_of_distance() {
         let light = PointLight::new(Vec3::new(0.0, 2.0, 0.0), Rgb::splat(8.0));
         let mut out = [LightSample::default(); 2];
-        light.sample(&[Vec3::ZERO, Vec3::new(0.0, -2.0, 0.0)], &[Vec2::ZERO; 2], &mut out);
+        light.sample(
+            &[Vec3::ZERO, Vec3::new(0.0, -2.0, 0.0)],
+            &[Vec2::ZERO; 2],
+            &mut out,
+        );
         assert_eq!(out[0].radiance, Rgb::splat(2.0));
         assert_eq!(out[1].radiance, Rgb::splat(0.5));
         assert!(light.is_delta());

@@ -86,7 +86,9 @@ mod tests {
         // Across samples of one pixel, and across dimensions of one sample:
         // both must look uniform in 2D (16×16 bins, 255 dof; the 99.9%
         // quantile is about 330).
-        let ids: Vec<SampleId> = (0..40_000).map(|i| SampleId { pixel: 7, index: i }).collect();
+        let ids: Vec<SampleId> = (0..40_000)
+            .map(|i| SampleId { pixel: 7, index: i })
+            .collect();
         let mut out = vec![Vec2::ZERO; ids.len()];
         s.fill_2d(&ids, 4, &mut out);
         assert!(chi2_uniform_2d(&out, 16) < 330.0);

@@ -133,7 +133,13 @@ mod tests {
         let wo = vec![Vec3::new(0.6, 0.0, 0.8); n * n];
         let uv = vec![Vec2::ZERO; n * n];
         let u: Vec<Vec3> = (0..n * n)
-            .map(|i| Vec3::new(0.5, ((i % n) as f32 + 0.5) / n as f32, ((i / n) as f32 + 0.5) / n as f32))
+            .map(|i| {
+                Vec3::new(
+                    0.5,
+                    ((i % n) as f32 + 0.5) / n as f32,
+                    ((i / n) as f32 + 0.5) / n as f32,
+                )
+            })
             .collect();
         let surface = SurfaceBatch { wo: &wo, uv: &uv };
         let mut samples = vec![BsdfSample::default(); n * n];
@@ -159,7 +165,10 @@ mod tests {
         let white = textures.add_constant(Rgb::ONE);
         let shader = Diffuse::new(white, Effects::empty());
         let mut ctx = ShadeContext::new(&textures);
-        let surface = SurfaceBatch { wo: &[Vec3::new(0.0, 0.0, -1.0)], uv: &[Vec2::ZERO] };
+        let surface = SurfaceBatch {
+            wo: &[Vec3::new(0.0, 0.0, -1.0)],
+            uv: &[Vec2::ZERO],
+        };
         let mut e = [BsdfEval::default()];
         shader.eval(&mut ctx, surface, &[Vec3::Z], &mut e);
         assert_eq!(e[0].value, Rgb::ZERO);

@@ -71,7 +71,9 @@ mod tests {
 
     #[test]
     fn constant_is_constant() {
-        let t = Constant { value: Rgb::new(0.1, 0.2, 0.3) };
+        let t = Constant {
+            value: Rgb::new(0.1, 0.2, 0.3),
+        };
         let mut out = [Rgb::ZERO; 3];
         t.eval(&[Vec2::ZERO, Vec2::ONE, Vec2::splat(0.5)], &mut out);
         assert!(out.iter().all(|&c| c == Rgb::new(0.1, 0.2, 0.3)));

@@ -1,0 +1,101 @@
+//! The CPU backend: the frame is cut into tiles, each tile's samples are
+//! rendered as wavefront batches on a rayon worker, and tile films are
+//! merged in tile order (so results do not depend on the thread count).
+
+use crate::extract::RenderScene;
+use crate::film::{Film, FilterTable, Image, TileFilm};
+use crate::integrators::path::{Batch, Wavefront};
+use rayon::prelude::*;
+use std::time::{Duration, Instant};
+
+/// Tile edge in pixels.
+const TILE: u32 = 16;
+/// Paths per wavefront batch (about): a tile's pixels × a few samples.
+const BATCH_PATHS: u32 = 1024;
+
+/// Receives progress as tiles finish.
+pub struct Progress<'a> {
+    callback: Option<&'a (dyn Fn(u64, u64) + Sync)>,
+}
+
+impl<'a> Progress<'a> {
+    /// No progress reporting.
+    pub fn none() -> Self {
+        Self { callback: None }
+    }
+
+    /// Calls `f(done, total)` (in samples) as work finishes.
+    pub fn new(f: &'a (dyn Fn(u64, u64) + Sync)) -> Self {
+        Self { callback: Some(f) }
+    }
+}
+
+/// A finished render.
+pub struct Rendered {
+    /// The developed image.
+    pub image: Image,
+    /// Wall time of the rendering (extract and BVH excluded).
+    pub time: Duration,
+    /// Camera paths traced (pixels × spp).
+    pub samples: u64,
+    /// Rays traced (camera, continuation and shadow rays).
+    pub rays: u64,
+    /// Samples that were NaN or infinite and recorded as zero.
+    pub invalid_samples: u64,
+}
+
+/// Renders `scene` on all threads of the current rayon pool.
+pub fn render(scene: &RenderScene, progress: &Progress<'_>) -> Rendered {
+    let start = Instant::now();
+    let s = &scene.settings;
+    let (w, h) = (s.width, s.height);
+    let table = FilterTable::new(scene.filter.as_ref());
+    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
+        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
+        .collect();
+    let total = w as u64 * h as u64 * s.spp as u64;
+    let done = std::sync::atomic::AtomicU64::new(0);
+    let results: Vec<(TileFilm, u64)> = tiles
+        .par_iter()
+        .map_init(Wavefront::default, |wave, &(x0, y0)| {
+            let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
+            let pixels = (x1 - x0) * (y1 - y0);
+            let chunk = (BATCH_PATHS / pixels).max(1);
+            let mut tile = TileFilm::new(x0, y0, x1, y1, (w, h), table.radius());
+            let rays_before = wave.rays;
+            let mut first = 0;
+            while first < s.spp {
+                let samples = chunk.min(s.spp - first);
+                let batch = Batch {
+                    x0,
+                    y0,
+                    x1,
+                    y1,
+                    first_sample: first,
+                    samples,
+                };
+                wave.render(scene, batch, &table, &mut tile);
+                first += samples;
+                if let Some(f) = progress.callback {
+                    let n = pixels as u64 * samples as u64;
+                    let d = done.fetch_add(n, std::sync::atomic::Ordering::Relaxed) + n;
+                    f(d, total);
+                }
+            }
+            (tile, wave.rays - rays_before)
+        })
+        .collect();
+    let mut film = Film::new(w, h);
+    let mut rays = 0;
+    for (tile, r) in &results {
+        film.merge(tile);
+        rays += r;
+    }
+    Rendered {
+        image: film.develop(),
+        time: start.elapsed(),
+        samples: total,
+        rays,
+        invalid_samples: film.invalid_samples,
+    }
+}

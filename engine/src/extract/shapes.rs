@@ -1,0 +1,156 @@
+//! Tessellation of the scene's shapes into render-space primitives.
+
+use crate::world::Geometry;
+use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};
+
+/// One primitive with its shading attributes, in render space.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum ShapePrim {
+    /// A triangle with per-vertex normals (zero = use the face normal) and
+    /// texture coordinates.
+    Triangle {
+        v: [Vec3; 3],
+        n: [Vec3; 3],
+        uv: [Vec2; 3],
+    },
+    /// A sphere.
+    Sphere { centre: Vec3, radius: f32 },
+}
+
+/// Face `normal` with tangent axes (u, v) such that u × v = normal.
+const CUBE_FACES: [(DVec3, DVec3, DVec3); 6] = [
+    (DVec3::X, DVec3::Y, DVec3::Z),
+    (DVec3::NEG_X, DVec3::Z, DVec3::Y),
+    (DVec3::Y, DVec3::Z, DVec3::X),
+    (DVec3::NEG_Y, DVec3::X, DVec3::Z),
+    (DVec3::Z, DVec3::X, DVec3::Y),
+    (DVec3::NEG_Z, DVec3::Y, DVec3::X),
+];
+
+/// Tessellates `geometry` under `to_world`, then shifts it so that
+/// `render_origin` becomes the origin, appending to `out`.
+pub(crate) fn tessellate(
+    geometry: &Geometry,
+    to_world: DMat4,
+    render_origin: DVec3,
+    out: &mut Vec<ShapePrim>,
+) {
+    let point = |p: DVec3| (to_world.transform_point3(p) - render_origin).as_vec3();
+    let normal_matrix = DMat3::from_mat4(to_world).inverse().transpose();
+    let normal = |n: DVec3| (normal_matrix * n).normalize_or_zero().as_vec3();
+    // A mirroring transform reverses the winding; swap two vertices so the
+    // face normal stays the transformed normal.
+    let mirrored = to_world.determinant() < 0.0;
+    let mut push = |v: [Vec3; 3], n: [Vec3; 3], uv: [Vec2; 3]| {
+        if mirrored {
+            out.push(ShapePrim::Triangle {
+                v: [v[0], v[2], v[1]],
+                n: [n[0], n[2], n[1]],
+                uv: [uv[0], uv[2], uv[1]],
+            });
+        } else {
+            out.push(ShapePrim::Triangle { v, n, uv });
+        }
+    };
+    let quad = |push: &mut dyn FnMut([Vec3; 3], [Vec3; 3], [Vec2; 3]), c: [DVec3; 4]| {
+        let p = c.map(point);
+        let uv = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
+        let flat = [Vec3::ZERO; 3];
+        push([p[0], p[1], p[2]], flat, [uv[0], uv[1], uv[2]]);
+        push([p[0], p[2], p[3]], flat, [uv[0], uv[2], uv[3]]);
+    };
+    match geometry {
+        Geometry::Rectangle => quad(
+            &mut push,
+            [
+                DVec3::new(-1.0, -1.0, 0.0),
+                DVec3::new(1.0, -1.0, 0.0),
+                DVec3::new(1.0, 1.0, 0.0),
+                DVec3::new(-1.0, 1.0, 0.0),
+            ],
+        ),
+        Geometry::Cube => {
+            for (n, u, v) in CUBE_FACES {
+                quad(&mut push, [n - u - v, n + u - v, n + u + v, n - u + v]);
+            }
+        }
+        Geometry::Sphere => {
+            let centre = point(DVec3::ZERO);
+            let radius = to_world.transform_vector3(DVec3::X).length() as f32;
+            out.push(ShapePrim::Sphere { centre, radius });
+        }
+        Geometry::Mesh(mesh) => {
+            for t in &mesh.triangles {
+                let idx = t.map(|i| i as usize);
+                let v = idx.map(|i| point(mesh.positions[i].as_dvec3()));
+                let n = match &mesh.normals {
+                    Some(ns) if idx.iter().all(|&i| ns[i] != Vec3::ZERO) => {
+                        idx.map(|i| normal(ns[i].as_dvec3()))
+                    }
+                    _ => [Vec3::ZERO; 3],
+                };
+                let uv = match &mesh.uvs {
+                    Some(uvs) => idx.map(|i| uvs[i]),
+                    None => [Vec2::ZERO, Vec2::X, Vec2::Y],
+                };
+                push(v, n, uv);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn face_normal(p: &ShapePrim) -> Vec3 {
+        match p {
+            ShapePrim::Triangle { v, .. } => (v[1] - v[0]).cross(v[2] - v[0]).normalize(),
+            ShapePrim::Sphere { .. } => unreachable!(),
+        }
+    }
+
+    #[test]
+    fn cube_faces_point_outwards() {
+        let mut prims = Vec::new();
+        tessellate(&Geometry::Cube, DMat4::IDENTITY, DVec3::ZERO, &mut prims);
+        assert_eq!(prims.len(), 12);
+        for p in &prims {
+            let ShapePrim::Triangle { v, .. } = p else {
+                unreachable!()
+            };
+            let centre = (v[0] + v[1] + v[2]) / 3.0;
+            assert!(face_normal(p).dot(centre) > 0.0);
+        }
+    }
+
+    #[test]
+    fn rectangle_keeps_its_normal_under_mirroring() {
+        for m in [
+            DMat4::IDENTITY,
+            DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
+        ] {
+            let mut prims = Vec::new();
+            tessellate(&Geometry::Rectangle, m, DVec3::ZERO, &mut prims);
+            for p in &prims {
+                assert!((face_normal(p) - Vec3::Z).length() < 1e-6);
+            }
+        }
+    }
+
+    #[test]
+    fn render_origin_is_subtracted_in_double_precision() {
+        let mut prims = Vec::new();
+        let far = DVec3::splat(1e6);
+        tessellate(
+            &Geometry::Rectangle,
+            DMat4::from_translation(far) * DMat4::from_scale(DVec3::splat(1e-3)),
+            far,
+            &mut prims,
+        );
+        let ShapePrim::Triangle { v, .. } = prims[0] else {
+            unreachable!()
+        };
+        assert_eq!(v[0], Vec3::new(-1e-3, -1e-3, 0.0));
+    }
+}

@@ -1,0 +1,255 @@
+//! The film: filtered accumulation of samples, and image output.
+//!
+//! Each render task splats its samples into a [`TileFilm`] that covers its
+//! pixels plus the filter's border; tiles are merged into the [`Film`] in a
+//! fixed order, so a render is bit-identical whatever the thread count.
+//! A pixel's value is Σ w·L / Σ w over the samples whose filter footprint
+//! covers it (Mitsuba 3 and pbrt semantics).
+
+pub mod output;
+
+use glam::{Vec2, Vec4};
+use radiant_core::{Filter, Rgb};
+
+/// Entries per axis of the tabulated filter quadrant.
+const TABLE_RES: usize = 64;
+
+/// A filter tabulated over one quadrant [0, r]² (filters are symmetric).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FilterTable {
+    radius: f32,
+    scale: f32,
+    values: Vec<f32>,
+}
+
+impl FilterTable {
+    /// Tabulates `filter` at the centres of a 64×64 grid over [0, r]².
+    pub fn new(filter: &dyn Filter) -> Self {
+        let radius = filter.radius();
+        let step = radius / TABLE_RES as f32;
+        let mut values = Vec::with_capacity(TABLE_RES * TABLE_RES);
+        for y in 0..TABLE_RES {
+            for x in 0..TABLE_RES {
+                values.push(filter.eval((x as f32 + 0.5) * step, (y as f32 + 0.5) * step));
+            }
+        }
+        Self {
+            radius,
+            scale: TABLE_RES as f32 / radius,
+            values,
+        }
+    }
+
+    /// The filter's radius in pixels.
+    pub fn radius(&self) -> f32 {
+        self.radius
+    }
+
+    /// The filter's weight at offset (`dx`, `dy`).
+    #[inline]
+    pub fn weight(&self, dx: f32, dy: f32) -> f32 {
+        let ix = (dx.abs() * self.scale) as usize;
+        let iy = (dy.abs() * self.scale) as usize;
+        if ix >= TABLE_RES || iy >= TABLE_RES {
+            0.0
+        } else {
+            self.values[iy * TABLE_RES + ix]
+        }
+    }
+}
+
+/// A linear-RGB image.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Row-major pixels, top row first.
+    pub pixels: Vec<Rgb>,
+}
+
+impl Image {
+    /// Mean over all pixels and channels.
+    pub fn mean(&self) -> f64 {
+        self.pixels
+            .iter()
+            .map(|p| (p.x + p.y + p.z) as f64)
+            .sum::<f64>()
+            / (3 * self.pixels.len().max(1)) as f64
+    }
+}
+
+/// The weighted sums of one render task's pixels, with a border as wide as
+/// the filter.
+#[derive(Debug, Clone)]
+pub struct TileFilm {
+    x0: i32,
+    y0: i32,
+    width: i32,
+    height: i32,
+    image_width: i32,
+    image_height: i32,
+    /// (Σ w·r, Σ w·g, Σ w·b, Σ w) per pixel.
+    sums: Vec<Vec4>,
+    /// Samples whose value was NaN or infinite (recorded as zero).
+    pub invalid_samples: u64,
+}
+
+impl TileFilm {
+    /// A tile for the pixels [x0, x1) × [y0, y1) of a `size` image, grown by
+    /// the filter radius and clipped to the image.
+    pub fn new(x0: u32, y0: u32, x1: u32, y1: u32, size: (u32, u32), radius: f32) -> Self {
+        let border = radius.ceil() as i32;
+        let (w, h) = (size.0 as i32, size.1 as i32);
+        let bx0 = (x0 as i32 - border).max(0);
+        let by0 = (y0 as i32 - border).max(0);
+        let bx1 = (x1 as i32 + border).min(w);
+        let by1 = (y1 as i32 + border).min(h);
+        Self {
+            x0: bx0,
+            y0: by0,
+            width: bx1 - bx0,
+            height: by1 - by0,
+            image_width: w,
+            image_height: h,
+            sums: vec![Vec4::ZERO; ((bx1 - bx0) * (by1 - by0)) as usize],
+            invalid_samples: 0,
+        }
+    }
+
+    /// Adds `value` sampled at raster position `pos` to every pixel within
+    /// the filter's radius.
+    #[inline]
+    pub fn splat(&mut self, pos: Vec2, value: Rgb, table: &FilterTable) {
+        let value = if value.is_finite() {
+            value
+        } else {
+            self.invalid_samples += 1;
+            Rgb::ZERO
+        };
+        let r = table.radius;
+        let px0 = ((pos.x - 0.5 - r).ceil() as i32).max(0);
+        let px1 = ((pos.x - 0.5 + r).floor() as i32).min(self.image_width - 1);
+        let py0 = ((pos.y - 0.5 - r).ceil() as i32).max(0);
+        let py1 = ((pos.y - 0.5 + r).floor() as i32).min(self.image_height - 1);
+        let v = value.extend(1.0);
+        for y in py0..=py1 {
+            let dy = y as f32 + 0.5 - pos.y;
+            let row = ((y - self.y0) * self.width - self.x0) as usize;
+            for x in px0..=px1 {
+                let w = table.weight(x as f32 + 0.5 - pos.x, dy);
+                if w != 0.0 {
+                    self.sums[row + x as usize] += v * w;
+                }
+            }
+        }
+    }
+}
+
+/// The whole image's weighted sums.
+#[derive(Debug, Clone)]
+pub struct Film {
+    width: u32,
+    height: u32,
+    sums: Vec<Vec4>,
+    /// Samples whose value was NaN or infinite (recorded as zero).
+    pub invalid_samples: u64,
+}
+
+impl Film {
+    /// An empty film.
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            sums: vec![Vec4::ZERO; (width * height) as usize],
+            invalid_samples: 0,
+        }
+    }
+
+    /// Adds a tile's sums.
+    pub fn merge(&mut self, tile: &TileFilm) {
+        for y in 0..tile.height {
+            let src = (y * tile.width) as usize;
+            let dst = ((tile.y0 + y) as u32 * self.width + tile.x0 as u32) as usize;
+            for x in 0..tile.width as usize {
+                self.sums[dst + x] += tile.sums[src + x];
+            }
+        }
+        self.invalid_samples += tile.invalid_samples;
+    }
+
+    /// The reconstructed image: Σ w·L / Σ w per pixel.
+    pub fn develop(&self) -> Image {
+        Image {
+            width: self.width,
+            height: self.height,
+            pixels: self
+                .sums
+                .iter()
+                .map(|s| {
+                    if s.w > 0.0 {
+                        s.truncate() / s.w
+                    } else {
+                        Rgb::ZERO
+                    }
+                })
+                .collect(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Tent;
+    impl Filter for Tent {
+        fn radius(&self) -> f32 {
+            1.5
+        }
+        fn eval(&self, x: f32, y: f32) -> f32 {
+            (1.5 - x.abs()).max(0.0) * (1.5 - y.abs()).max(0.0)
+        }
+    }
+
+    #[test]
+    fn constant_signal_develops_to_itself_with_tiles() {
+        let table = FilterTable::new(&Tent);
+        let (w, h) = (9u32, 7u32);
+        let mut film = Film::new(w, h);
+        for (x0, y0, x1, y1) in [(0, 0, 5, 7), (5, 0, 9, 4), (5, 4, 9, 7)] {
+            let mut tile = TileFilm::new(x0, y0, x1, y1, (w, h), table.radius());
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    for s in 0..4 {
+                        let pos = Vec2::new(
+                            x as f32 + 0.2 + 0.2 * s as f32,
+                            y as f32 + 0.9 - 0.2 * s as f32,
+                        );
+                        tile.splat(pos, Rgb::new(0.25, 0.5, 1.0), &table);
+                    }
+                }
+            }
+            film.merge(&tile);
+        }
+        let image = film.develop();
+        for p in &image.pixels {
+            assert!((*p - Rgb::new(0.25, 0.5, 1.0)).abs().max_element() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn invalid_samples_are_counted_not_splatted() {
+        let table = FilterTable::new(&Tent);
+        let mut tile = TileFilm::new(0, 0, 2, 2, (2, 2), table.radius());
+        tile.splat(Vec2::splat(0.5), Rgb::new(f32::NAN, 0.0, 0.0), &table);
+        tile.splat(Vec2::splat(0.5), Rgb::splat(f32::INFINITY), &table);
+        assert_eq!(tile.invalid_samples, 2);
+        let mut film = Film::new(2, 2);
+        film.merge(&tile);
+        assert!(film.develop().pixels.iter().all(|p| p.is_finite()));
+        assert_eq!(film.invalid_samples, 2);
+    }
+}

@@ -1,0 +1,514 @@
+//! The wavefront path tracer.
+//!
+//! Unidirectional path tracing with next-event estimation at every vertex
+//! with a non-delta lobe, multiple importance sampling (power heuristic)
+//! between BSDF and light sampling, lights chosen in proportion to power,
+//! and Russian roulette driven by path throughput from `rr_depth` on —
+//! the estimator of Mitsuba 3's `path` integrator, with the same
+//! `max_depth` semantics (1 = emitters seen directly, 2 = direct light, …).
+//!
+//! All paths of a batch advance together, one bounce per iteration, so the
+//! bounce count is the same for every live path. Each stage is a loop over
+//! the live paths' slots (structure of arrays); modules are called once per
+//! group of paths that share a material or a light.
+
+use super::sort::sort_by_key;
+use super::surface::{Interaction, interaction};
+use crate::accel::Hit;
+use crate::accel::offset::{offset_origin, sampled_point_error};
+use crate::extract::{NO_EMITTER, RenderScene};
+use crate::film::{FilterTable, TileFilm};
+use glam::{Vec2, Vec3};
+use radiant_core::{
+    BsdfEval, BsdfSample, CameraRays, Effects, EmitterEval, EmitterHit, LightSample, Rgb, SampleId,
+    ShadeContext, SurfaceBatch,
+};
+
+/// Sampler dimensions used by the camera (film jitter, lens).
+const CAMERA_DIMS: u32 = 4;
+/// Sampler dimensions used per bounce: light choice, light point (2),
+/// lobe choice, direction (2), Russian roulette, one spare.
+const BOUNCE_DIMS: u32 = 8;
+/// Depth at which unlimited paths (`max_depth: -1`) are cut, as a guard
+/// against scenes where Russian roulette is configured never to start.
+pub const UNLIMITED_DEPTH_CAP: u32 = 1024;
+/// Shadow rays stop this fraction short of the light (pbrt's ShadowEpsilon).
+const SHADOW_EPSILON: f32 = 1e-4;
+
+/// Pixels and samples one batch renders.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Batch {
+    /// Pixel rectangle [x0, x1) × [y0, y1).
+    pub x0: u32,
+    /// See `x0`.
+    pub y0: u32,
+    /// See `x0`.
+    pub x1: u32,
+    /// See `x0`.
+    pub y1: u32,
+    /// First sample index.
+    pub first_sample: u32,
+    /// Number of samples per pixel in this batch.
+    pub samples: u32,
+}
+
+/// Per-thread state of the wavefront: structure-of-arrays path state and
+/// scratch buffers, reused from batch to batch (no per-ray allocation).
+#[derive(Default)]
+pub struct Wavefront {
+    // Path state, indexed by slot.
+    ids: Vec<SampleId>,
+    film: Vec<Vec2>,
+    origin: Vec<Vec3>,
+    dir: Vec<Vec3>,
+    beta: Vec<Rgb>,
+    radiance: Vec<Rgb>,
+    prev_pdf: Vec<f32>,
+    hit: Vec<Hit>,
+    its: Vec<Interaction>,
+    // Live slots, and sort scratch.
+    live: Vec<u32>,
+    next_live: Vec<u32>,
+    scratch: Vec<u32>,
+    offsets: Vec<u32>,
+    // Per live path in material order (index k).
+    ids_k: Vec<SampleId>,
+    wo: Vec<Vec3>,
+    uv: Vec<Vec2>,
+    u1: Vec<f32>,
+    u2: Vec<Vec2>,
+    u3: Vec<Vec3>,
+    bsdf: Vec<BsdfSample>,
+    nee_wi: Vec<Vec3>,
+    nee_eval: Vec<BsdfEval>,
+    light: Vec<u32>,
+    light_prob: Vec<f32>,
+    light_sample: Vec<LightSample>,
+    // Grouping by light.
+    by_light: Vec<u32>,
+    light_offsets: Vec<u32>,
+    refs: Vec<Vec3>,
+    light_u: Vec<Vec2>,
+    light_out: Vec<LightSample>,
+    // Emitter hits.
+    em_slots: Vec<u32>,
+    em_hits: Vec<EmitterHit>,
+    em_evals: Vec<EmitterEval>,
+    // Shadow rays.
+    shadow_slot: Vec<u32>,
+    shadow_origin: Vec<Vec3>,
+    shadow_dir: Vec<Vec3>,
+    shadow_value: Vec<Rgb>,
+    /// Rays traced so far (camera, continuation and shadow rays).
+    pub rays: u64,
+}
+
+fn fit<T: Clone + Default>(v: &mut Vec<T>, n: usize) {
+    v.clear();
+    v.resize(n, T::default());
+}
+
+#[inline]
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 > 0.0 { a2 / (a2 + b2) } else { 0.0 }
+}
+
+impl Wavefront {
+    /// Renders `batch` and splats its samples into `tile`.
+    pub fn render(
+        &mut self,
+        scene: &RenderScene,
+        batch: Batch,
+        table: &FilterTable,
+        tile: &mut TileFilm,
+    ) {
+        let n = ((batch.x1 - batch.x0) * (batch.y1 - batch.y0) * batch.samples) as usize;
+        self.generate(scene, batch, n);
+        if scene.settings.max_depth != 0 {
+            self.trace_paths(scene);
+        }
+        for i in 0..n {
+            tile.splat(self.film[i], self.radiance[i], table);
+        }
+    }
+
+    fn generate(&mut self, scene: &RenderScene, b: Batch, n: usize) {
+        let width = scene.settings.width;
+        fit(&mut self.ids, n);
+        let mut i = 0;
+        for y in b.y0..b.y1 {
+            for x in b.x0..b.x1 {
+                for s in b.first_sample..b.first_sample + b.samples {
+                    self.ids[i] = SampleId {
+                        pixel: y * width + x,
+                        index: s,
+                    };
+                    i += 1;
+                }
+            }
+        }
+        fit(&mut self.film, n);
+        fit(&mut self.u2, n);
+        scene.sampler.fill_2d(&self.ids, 0, &mut self.film);
+        scene.sampler.fill_2d(&self.ids, 2, &mut self.u2);
+        for (f, id) in self.film.iter_mut().zip(&self.ids) {
+            *f += Vec2::new((id.pixel % width) as f32, (id.pixel / width) as f32);
+        }
+        fit(&mut self.origin, n);
+        fit(&mut self.dir, n);
+        fit(&mut self.u1, n);
+        scene.camera.generate(
+            &self.film,
+            &self.u2,
+            CameraRays {
+                origins: &mut self.origin,
+                directions: &mut self.dir,
+                weights: &mut self.u1,
+            },
+        );
+        fit(&mut self.beta, n);
+        for (b, w) in self.beta.iter_mut().zip(&self.u1) {
+            *b = Rgb::splat(*w);
+        }
+        fit(&mut self.radiance, n);
+        fit(&mut self.prev_pdf, n);
+        fit(&mut self.hit, n);
+        self.its.resize(
+            n,
+            Interaction {
+                p: Vec3::ZERO,
+                err: Vec3::ZERO,
+                ng: Vec3::Z,
+                frame: radiant_core::Frame::from_normal(Vec3::Z),
+                uv: Vec2::ZERO,
+            },
+        );
+        self.live.clear();
+        self.live.extend(0..n as u32);
+    }
+
+    fn trace_paths(&mut self, scene: &RenderScene) {
+        let s = &scene.settings;
+        let max_depth = if s.max_depth < 0 {
+            UNLIMITED_DEPTH_CAP
+        } else {
+            s.max_depth as u32
+        };
+        let has_lights = !scene.lights.is_empty();
+        let has_area = scene.effects.contains(Effects::AREA_LIGHTS);
+        let mut depth = 0u32;
+        while !self.live.is_empty() {
+            self.trace_closest(scene);
+            self.resolve_hits(scene, depth, has_area);
+            if depth + 1 >= max_depth {
+                break;
+            }
+            let n = self.sort_by_material(scene);
+            let base = CAMERA_DIMS + depth * BOUNCE_DIMS;
+            if has_lights {
+                self.sample_lights(scene, n, base);
+            }
+            self.shade(scene, base);
+            if has_lights {
+                self.next_event(scene, n);
+            }
+            self.continue_paths(scene, depth, base);
+            depth += 1;
+        }
+    }
+
+    fn trace_closest(&mut self, scene: &RenderScene) {
+        for &slot in &self.live {
+            let i = slot as usize;
+            self.hit[i] = scene
+                .accel
+                .intersect(self.origin[i], self.dir[i], f32::INFINITY)
+                .unwrap_or(Hit {
+                    t: f32::INFINITY,
+                    prim: u32::MAX,
+                    b1: 0.0,
+                    b2: 0.0,
+                });
+        }
+        self.rays += self.live.len() as u64;
+    }
+
+    /// Drops paths that escaped, resolves hits, adds emission.
+    fn resolve_hits(&mut self, scene: &RenderScene, depth: u32, has_area: bool) {
+        self.em_slots.clear();
+        self.next_live.clear();
+        for &slot in &self.live {
+            let i = slot as usize;
+            let hit = self.hit[i];
+            if hit.prim == u32::MAX {
+                continue;
+            }
+            self.its[i] = interaction(scene, &hit, self.origin[i], self.dir[i]);
+            if has_area && scene.surfaces.emitter[hit.prim as usize] != NO_EMITTER {
+                self.em_slots.push(slot);
+            }
+            self.next_live.push(slot);
+        }
+        std::mem::swap(&mut self.live, &mut self.next_live);
+        if self.em_slots.is_empty() {
+            return;
+        }
+        let surfaces = &scene.surfaces;
+        let hits = &self.hit;
+        let nlights = scene.lights.len();
+        sort_by_key(
+            &mut self.em_slots,
+            &mut self.scratch,
+            &mut self.offsets,
+            nlights,
+            |slot| surfaces.emitter[hits[slot as usize].prim as usize],
+        );
+        fit(&mut self.em_hits, self.em_slots.len());
+        fit(&mut self.em_evals, self.em_slots.len());
+        for (k, &slot) in self.em_slots.iter().enumerate() {
+            let i = slot as usize;
+            self.em_hits[k] = EmitterHit {
+                origin: self.origin[i],
+                p: self.its[i].p,
+                n: self.its[i].ng,
+                primitive: surfaces.emitter_prim[self.hit[i].prim as usize],
+            };
+        }
+        for light in 0..nlights {
+            let (a, b) = (
+                self.offsets[light] as usize,
+                self.offsets[light + 1] as usize,
+            );
+            if a < b {
+                scene.lights.lights()[light]
+                    .eval_hits(&self.em_hits[a..b], &mut self.em_evals[a..b]);
+            }
+        }
+        for light in 0..nlights {
+            let pmf = scene.lights.pmf(light);
+            for k in self.offsets[light] as usize..self.offsets[light + 1] as usize {
+                let i = self.em_slots[k] as usize;
+                let e = self.em_evals[k];
+                let w = if depth == 0 || self.prev_pdf[i] == 0.0 {
+                    1.0
+                } else {
+                    power_heuristic(self.prev_pdf[i], pmf * e.pdf)
+                };
+                self.radiance[i] += self.beta[i] * e.radiance * w;
+            }
+        }
+    }
+
+    /// Sorts live paths by material and gathers their shading inputs.
+    fn sort_by_material(&mut self, scene: &RenderScene) -> usize {
+        let surfaces = &scene.surfaces;
+        let hits = &self.hit;
+        sort_by_key(
+            &mut self.live,
+            &mut self.scratch,
+            &mut self.offsets,
+            scene.shaders.len(),
+            |slot| surfaces.material[hits[slot as usize].prim as usize],
+        );
+        let n = self.live.len();
+        fit(&mut self.ids_k, n);
+        fit(&mut self.wo, n);
+        fit(&mut self.uv, n);
+        for (k, &slot) in self.live.iter().enumerate() {
+            let i = slot as usize;
+            self.ids_k[k] = self.ids[i];
+            self.wo[k] = self.its[i].frame.to_local(-self.dir[i]);
+            self.uv[k] = self.its[i].uv;
+        }
+        n
+    }
+
+    /// Chooses a light per path and samples a point on it, one module call
+    /// per light.
+    fn sample_lights(&mut self, scene: &RenderScene, n: usize, base: u32) {
+        fit(&mut self.u1, n);
+        fit(&mut self.u2, n);
+        scene.sampler.fill_1d(&self.ids_k, base, &mut self.u1);
+        scene.sampler.fill_2d(&self.ids_k, base + 1, &mut self.u2);
+        fit(&mut self.light, n);
+        fit(&mut self.light_prob, n);
+        for k in 0..n {
+            let (l, p, rescaled) = scene.lights.select(self.u1[k]);
+            self.light[k] = l as u32;
+            self.light_prob[k] = p;
+            self.u1[k] = rescaled;
+        }
+        self.by_light.clear();
+        self.by_light.extend(0..n as u32);
+        let lights = &self.light;
+        let offsets = &mut self.light_offsets;
+        sort_by_key(
+            &mut self.by_light,
+            &mut self.scratch,
+            offsets,
+            scene.lights.len(),
+            |k| lights[k as usize],
+        );
+        fit(&mut self.refs, n);
+        fit(&mut self.light_u, n);
+        fit(&mut self.light_out, n);
+        for (j, &k) in self.by_light.iter().enumerate() {
+            let k = k as usize;
+            self.refs[j] = self.its[self.live[k] as usize].p;
+            self.light_u[j] = self.u2[k];
+        }
+        for l in 0..scene.lights.len() {
+            let (a, b) = (offsets[l] as usize, offsets[l + 1] as usize);
+            if a < b {
+                scene.lights.lights()[l].sample(
+                    &self.refs[a..b],
+                    &self.light_u[a..b],
+                    &mut self.light_out[a..b],
+                );
+            }
+        }
+        fit(&mut self.light_sample, n);
+        for (j, &k) in self.by_light.iter().enumerate() {
+            self.light_sample[k as usize] = self.light_out[j];
+        }
+        // Directions towards the light samples, in the local frames.
+        fit(&mut self.nee_wi, n);
+        for k in 0..n {
+            let it = &self.its[self.live[k] as usize];
+            let wi = (self.light_sample[k].p - it.p).normalize_or_zero();
+            self.nee_wi[k] = it.frame.to_local(wi);
+        }
+    }
+
+    /// Calls each material's shader on its slice: BSDF samples for the
+    /// continuation, and evaluations towards the light samples.
+    fn shade(&mut self, scene: &RenderScene, base: u32) {
+        let n = self.live.len();
+        fit(&mut self.u3, n);
+        fit(&mut self.u1, n);
+        fit(&mut self.u2, n);
+        scene.sampler.fill_1d(&self.ids_k, base + 3, &mut self.u1);
+        scene.sampler.fill_2d(&self.ids_k, base + 4, &mut self.u2);
+        for k in 0..n {
+            self.u3[k] = Vec3::new(self.u1[k], self.u2[k].x, self.u2[k].y);
+        }
+        fit(&mut self.bsdf, n);
+        fit(&mut self.nee_eval, n);
+        let mut ctx = ShadeContext::new(&scene.textures);
+        let has_lights = !scene.lights.is_empty();
+        for (m, shader) in scene.shaders.iter().enumerate() {
+            let (a, b) = (self.offsets[m] as usize, self.offsets[m + 1] as usize);
+            if a == b {
+                continue;
+            }
+            let surface = SurfaceBatch {
+                wo: &self.wo[a..b],
+                uv: &self.uv[a..b],
+            };
+            shader.sample(&mut ctx, surface, &self.u3[a..b], &mut self.bsdf[a..b]);
+            if has_lights && shader.effects().contains(Effects::SMOOTH_LOBES) {
+                shader.eval(
+                    &mut ctx,
+                    surface,
+                    &self.nee_wi[a..b],
+                    &mut self.nee_eval[a..b],
+                );
+            }
+        }
+    }
+
+    /// Weights the light samples and traces their shadow rays.
+    fn next_event(&mut self, scene: &RenderScene, n: usize) {
+        self.shadow_slot.clear();
+        self.shadow_origin.clear();
+        self.shadow_dir.clear();
+        self.shadow_value.clear();
+        for k in 0..n {
+            let ls = self.light_sample[k];
+            let e = self.nee_eval[k];
+            if ls.pdf <= 0.0 || e.value == Rgb::ZERO {
+                continue;
+            }
+            let slot = self.live[k];
+            let i = slot as usize;
+            let it = &self.its[i];
+            let wi = it.frame.to_world(self.nee_wi[k]);
+            // Shading and geometric normals must agree on the side.
+            if wi.dot(it.ng) * self.nee_wi[k].z <= 0.0 {
+                continue;
+            }
+            let light_pdf = self.light_prob[k] * ls.pdf;
+            let delta = scene.lights.lights()[self.light[k] as usize].is_delta();
+            let w = if delta {
+                1.0
+            } else {
+                power_heuristic(light_pdf, e.pdf)
+            };
+            let value = self.beta[i] * e.value * ls.radiance * (w / light_pdf);
+            if value == Rgb::ZERO || !value.is_finite() {
+                continue;
+            }
+            let origin = offset_origin(it.p, it.err, it.ng, wi);
+            let target = if ls.n == Vec3::ZERO {
+                ls.p
+            } else {
+                offset_origin(ls.p, sampled_point_error(ls.p), ls.n, -wi)
+            };
+            self.shadow_slot.push(slot);
+            self.shadow_origin.push(origin);
+            self.shadow_dir.push(target - origin);
+            self.shadow_value.push(value);
+        }
+        for j in 0..self.shadow_slot.len() {
+            if !scene.accel.occluded(
+                self.shadow_origin[j],
+                self.shadow_dir[j],
+                1.0 - SHADOW_EPSILON,
+            ) {
+                self.radiance[self.shadow_slot[j] as usize] += self.shadow_value[j];
+            }
+        }
+        self.rays += self.shadow_slot.len() as u64;
+    }
+
+    /// Follows the BSDF samples, applies Russian roulette and compacts.
+    fn continue_paths(&mut self, scene: &RenderScene, depth: u32, base: u32) {
+        let n = self.live.len();
+        fit(&mut self.u1, n);
+        scene.sampler.fill_1d(&self.ids_k, base + 6, &mut self.u1);
+        let rr = depth + 1 >= scene.settings.rr_depth;
+        self.next_live.clear();
+        for k in 0..n {
+            let s = self.bsdf[k];
+            if s.pdf <= 0.0 || s.weight == Rgb::ZERO {
+                continue;
+            }
+            let slot = self.live[k];
+            let i = slot as usize;
+            let it = &self.its[i];
+            let wi = it.frame.to_world(s.wi);
+            if wi.dot(it.ng) * s.wi.z <= 0.0 {
+                continue;
+            }
+            let mut beta = self.beta[i] * s.weight;
+            let beta_max = beta.max_element();
+            if !(beta_max > 0.0) || !beta.is_finite() {
+                continue;
+            }
+            if rr {
+                let q = beta_max.min(0.95);
+                if self.u1[k] >= q {
+                    continue;
+                }
+                beta /= q;
+            }
+            self.beta[i] = beta;
+            self.prev_pdf[i] = if s.delta { 0.0 } else { s.pdf };
+            self.origin[i] = offset_origin(it.p, it.err, it.ng, wi);
+            self.dir[i] = wi;
+            self.next_live.push(slot);
+        }
+        std::mem::swap(&mut self.live, &mut self.next_live);
+    }
+}

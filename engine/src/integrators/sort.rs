@@ -1,0 +1,50 @@
+//! Counting sort of batch slots by a small key (material, light), the
+//! "coherent shading" step of sorted deferred shading.
+
+/// Reorders `items` by `key(item)` (stable), given `keys` distinct keys, and
+/// writes into `offsets` the start of each key's range (length `keys + 1`).
+pub(crate) fn sort_by_key(
+    items: &mut Vec<u32>,
+    scratch: &mut Vec<u32>,
+    offsets: &mut Vec<u32>,
+    keys: usize,
+    key: impl Fn(u32) -> u32,
+) {
+    offsets.clear();
+    offsets.resize(keys + 1, 0);
+    for &i in items.iter() {
+        offsets[key(i) as usize + 1] += 1;
+    }
+    for k in 0..keys {
+        offsets[k + 1] += offsets[k];
+    }
+    if offsets[1] as usize == items.len() {
+        return; // everything has key 0: already sorted
+    }
+    scratch.clear();
+    scratch.resize(items.len(), 0);
+    let mut next = offsets[..keys].to_vec();
+    for &i in items.iter() {
+        let k = key(i) as usize;
+        scratch[next[k] as usize] = i;
+        next[k] += 1;
+    }
+    std::mem::swap(items, scratch);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sorts_stably_and_reports_ranges() {
+        let keys = [2u32, 0, 1, 2, 0, 1, 1];
+        let mut items: Vec<u32> = (0..7).collect();
+        let (mut scratch, mut offsets) = (Vec::new(), Vec::new());
+        sort_by_key(&mut items, &mut scratch, &mut offsets, 3, |i| {
+            keys[i as usize]
+        });
+        assert_eq!(items, [1, 4, 2, 5, 6, 0, 3]);
+        assert_eq!(offsets, [0, 2, 5, 7]);
+    }
+}

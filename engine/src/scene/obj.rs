@@ -1,0 +1,148 @@
+//! Wavefront OBJ meshes (through tobj), repaired on load.
+//!
+//! Degenerate input is repaired, never passed on: triangles with
+//! non-finite coordinates or zero area are dropped, and vertex normals that
+//! are zero or non-finite are marked so the face normal is used instead.
+//! [`MeshRepairs`] counts what was done; `radiant info` reports it.
+
+use crate::world::{MeshData, MeshRepairs};
+use glam::{DVec3, Vec2, Vec3};
+use std::path::Path;
+
+/// Loads every object of an OBJ file into one mesh (materials are ignored).
+pub fn load_obj(path: &Path) -> Result<MeshData, String> {
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let (models, _materials) = tobj::load_obj(path, &options).map_err(|e| match e {
+        tobj::LoadError::OpenFileFailed => format!("cannot open mesh file `{}`", path.display()),
+        other => format!("cannot read mesh file `{}`: {other}", path.display()),
+    })?;
+    let mut mesh = MeshData::default();
+    let mut normals = Vec::new();
+    let mut uvs = Vec::new();
+    let all_have_normals = models.iter().all(|m| !m.mesh.normals.is_empty());
+    let all_have_uvs = models.iter().all(|m| !m.mesh.texcoords.is_empty());
+    for model in &models {
+        let m = &model.mesh;
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend(
+            m.positions
+                .chunks_exact(3)
+                .map(|p| Vec3::new(p[0], p[1], p[2])),
+        );
+        if all_have_normals {
+            normals.extend(
+                m.normals
+                    .chunks_exact(3)
+                    .map(|n| Vec3::new(n[0], n[1], n[2])),
+            );
+        }
+        if all_have_uvs {
+            uvs.extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])));
+        }
+        mesh.triangles.extend(
+            m.indices
+                .chunks_exact(3)
+                .map(|t| [base + t[0], base + t[1], base + t[2]]),
+        );
+    }
+    let n_vertices = mesh.positions.len();
+    if mesh
+        .triangles
+        .iter()
+        .flatten()
+        .any(|&i| i as usize >= n_vertices)
+    {
+        return Err(format!(
+            "mesh file `{}` refers to vertices that do not exist",
+            path.display()
+        ));
+    }
+    if all_have_normals && normals.len() == n_vertices {
+        mesh.normals = Some(normals);
+    }
+    if all_have_uvs && uvs.len() == n_vertices {
+        mesh.uvs = Some(uvs);
+    }
+    repair(&mut mesh);
+    if mesh.triangles.is_empty() {
+        return Err(format!(
+            "mesh file `{}` has no usable triangles ({} dropped as degenerate, {} for non-finite coordinates)",
+            path.display(),
+            mesh.repairs.degenerate,
+            mesh.repairs.non_finite
+        ));
+    }
+    Ok(mesh)
+}
+
+/// Drops unusable triangles and marks unusable normals (as zero vectors).
+pub fn repair(mesh: &mut MeshData) {
+    let mut repairs = MeshRepairs::default();
+    let positions = &mesh.positions;
+    mesh.triangles.retain(|t| {
+        let [a, b, c] = t.map(|i| positions[i as usize].as_dvec3());
+        if !(a.is_finite() && b.is_finite() && c.is_finite()) {
+            repairs.non_finite += 1;
+            return false;
+        }
+        if (b - a).cross(c - a) == DVec3::ZERO {
+            repairs.degenerate += 1;
+            return false;
+        }
+        true
+    });
+    if let Some(normals) = &mut mesh.normals {
+        for n in normals.iter_mut() {
+            match n.try_normalize() {
+                Some(unit) => *n = unit,
+                None => {
+                    *n = Vec3::ZERO;
+                    repairs.bad_normals += 1;
+                }
+            }
+        }
+    }
+    if let Some(uvs) = &mut mesh.uvs {
+        for uv in uvs.iter_mut().filter(|uv| !uv.is_finite()) {
+            *uv = Vec2::ZERO;
+        }
+    }
+    mesh.repairs = repairs;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Write;
+
+    #[test]
+    fn degenerate_input_is_repaired_and_counted() {
+        let mut f = tempfile::Builder::new().suffix(".obj").tempfile().unwrap();
+        writeln!(
+            f,
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv nan 0 0\nv 2 0 0\n\
+             vn 0 0 1\nvn 0 0 0\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\n\
+             f 1//1 2//2 3//3\nf 1//1 4//4 3//3\nf 1//1 2//2 5//5\nf 1//1 1//1 3//3\n"
+        )
+        .unwrap();
+        let mesh = load_obj(f.path()).unwrap();
+        assert_eq!(mesh.triangles.len(), 1);
+        assert_eq!(mesh.repairs.non_finite, 1);
+        assert_eq!(
+            mesh.repairs.degenerate, 2,
+            "collinear and repeated-vertex faces"
+        );
+        assert_eq!(mesh.repairs.bad_normals, 1);
+    }
+
+    #[test]
+    fn missing_file_is_an_error() {
+        let err = load_obj(Path::new("/nonexistent/mesh.obj")).unwrap_err();
+        assert!(err.contains("cannot open"), "{err}");
+    }
+}

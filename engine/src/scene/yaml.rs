@@ -1,0 +1,217 @@
+//! Reading the scene's YAML tree with positions kept for every node.
+
+use super::SceneError;
+use crate::world::ModuleSpec;
+use marked_yaml::types::MarkedMappingNode;
+use marked_yaml::{Node, Span};
+use radiant_core::Params;
+use radiant_core::params::Location;
+use serde::de::DeserializeOwned;
+use std::collections::HashSet;
+use std::path::Path;
+
+/// Where a node is.
+pub(crate) fn loc(span: &Span) -> Option<Location> {
+    Location::of(span)
+}
+
+/// Parses a YAML document into a tree of marked nodes.
+pub(crate) fn parse_document(file: &Path, text: &str) -> Result<Node, SceneError> {
+    use marked_yaml::LoadError;
+    let options = marked_yaml::LoaderOptions::default()
+        .error_on_duplicate_keys(true)
+        .toplevel_mapping();
+    marked_yaml::parse_yaml_with_options(0, text, options).map_err(|e| {
+        let (marker, message) = match &e {
+            LoadError::TopLevelMustBeMapping(m) => (
+                Some(*m),
+                "the scene must be a YAML mapping (`key: value` lines)".to_string(),
+            ),
+            LoadError::ScanError(m, err) => (Some(*m), format!("invalid YAML: {}", err.info())),
+            LoadError::DuplicateKey(inner) => (
+                inner.key.span().start().copied(),
+                format!("duplicate key `{}`", inner.key.as_str()),
+            ),
+            LoadError::UnexpectedAnchor(m) => (
+                Some(*m),
+                "YAML anchors and aliases are not supported".to_string(),
+            ),
+            LoadError::UnexpectedTag(m) => (Some(*m), "YAML tags are not supported".to_string()),
+            LoadError::MappingKeyMustBeScalar(m) => {
+                (Some(*m), "mapping keys must be plain names".to_string())
+            }
+            other => (None, other.to_string()),
+        };
+        let location = marker.map(|m| Location {
+            line: m.line(),
+            column: m.column(),
+        });
+        SceneError::new(file, location, message)
+    })
+}
+
+/// Deserializes `node` with serde, keeping positions in errors.
+pub(crate) fn parse_node<T: DeserializeOwned>(file: &Path, node: &Node) -> Result<T, SceneError> {
+    Params::new(node.clone())
+        .parse()
+        .map_err(|e| SceneError::from_param(file, e))
+}
+
+/// A mapping whose keys are checked against the allowed ones.
+pub(crate) struct Mapping<'a> {
+    file: &'a Path,
+    node: &'a MarkedMappingNode,
+    span: &'a Span,
+    what: &'a str,
+    used: HashSet<&'a str>,
+}
+
+impl<'a> Mapping<'a> {
+    /// Views `node` as a mapping; `what` names it in errors ("shape", …).
+    pub(crate) fn new(file: &'a Path, node: &'a Node, what: &'a str) -> Result<Self, SceneError> {
+        match node.as_mapping() {
+            Some(m) => Ok(Self {
+                file,
+                node: m,
+                span: node.span(),
+                what,
+                used: HashSet::new(),
+            }),
+            None => Err(SceneError::new(
+                file,
+                loc(node.span()),
+                format!("expected a mapping (`key: value` lines) for the {what}"),
+            )),
+        }
+    }
+
+    /// Where the mapping starts.
+    pub(crate) fn location(&self) -> Option<Location> {
+        loc(self.span)
+    }
+
+    /// The value of `key`, if present.
+    pub(crate) fn get(&mut self, key: &'a str) -> Option<&'a Node> {
+        self.used.insert(key);
+        self.node.get_node(key)
+    }
+
+    /// The value of `key`, or an error naming it.
+    pub(crate) fn require(&mut self, key: &'a str) -> Result<&'a Node, SceneError> {
+        self.get(key).ok_or_else(|| {
+            SceneError::new(
+                self.file,
+                self.location(),
+                format!("the {} needs a `{key}`", self.what),
+            )
+        })
+    }
+
+    /// A scalar string value of `key`, if present.
+    pub(crate) fn string(
+        &mut self,
+        key: &'a str,
+    ) -> Result<Option<(String, Option<Location>)>, SceneError> {
+        match self.get(key) {
+            None => Ok(None),
+            Some(n) => match n.as_scalar() {
+                Some(s) => Ok(Some((s.as_str().to_string(), loc(n.span())))),
+                None => Err(SceneError::new(
+                    self.file,
+                    loc(n.span()),
+                    format!("`{key}` of the {} must be a name", self.what),
+                )),
+            },
+        }
+    }
+
+    /// Fails on any key that was not asked for, listing the allowed ones.
+    pub(crate) fn finish(self, allowed: &[&str]) -> Result<(), SceneError> {
+        for (key, _) in self.node.iter() {
+            if !self.used.contains(key.as_str()) {
+                return Err(unknown_key(
+                    self.file,
+                    key.as_str(),
+                    loc(key.span()),
+                    self.what,
+                    allowed,
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The error for a key that is not allowed, with the closest allowed one.
+pub(crate) fn unknown_key(
+    file: &Path,
+    key: &str,
+    location: Option<Location>,
+    what: &str,
+    allowed: &[&str],
+) -> SceneError {
+    let hint = closest(key, allowed)
+        .map(|s| format!(" (did you mean `{s}`?)"))
+        .unwrap_or_default();
+    SceneError::new(
+        file,
+        location,
+        format!(
+            "unknown key `{key}` in the {what}{hint}; allowed keys: {}",
+            allowed.join(", ")
+        ),
+    )
+}
+
+/// The candidate closest to `word`, if it is close enough to be a typo.
+pub(crate) fn closest<'c>(word: &str, candidates: &[&'c str]) -> Option<&'c str> {
+    candidates
+        .iter()
+        .map(|c| (strsim::damerau_levenshtein(word, c), *c))
+        .filter(|(d, c)| *d <= 2.max(c.len() / 3))
+        .min()
+        .map(|(_, c)| c)
+}
+
+/// Splits a module mapping into its `type` and the parameters the module
+/// parses, leaving out `engine_keys` (which the caller reads from the
+/// returned mapping).
+pub(crate) fn module_spec(
+    file: &Path,
+    node: &Node,
+    what: &str,
+    engine_keys: &[&str],
+) -> Result<ModuleSpec, SceneError> {
+    let map = node.as_mapping().ok_or_else(|| {
+        SceneError::new(
+            file,
+            loc(node.span()),
+            format!("expected a mapping with a `type` for the {what}"),
+        )
+    })?;
+    let type_node = map.get_node("type").ok_or_else(|| {
+        SceneError::new(file, loc(node.span()), format!("the {what} needs a `type`"))
+    })?;
+    let type_name = type_node
+        .as_scalar()
+        .ok_or_else(|| {
+            SceneError::new(
+                file,
+                loc(type_node.span()),
+                format!("the {what}'s `type` must be a name"),
+            )
+        })?
+        .as_str()
+        .to_string();
+    let mut rest = MarkedMappingNode::new_empty(*node.span());
+    for (k, v) in map.iter() {
+        if k.as_str() != "type" && !engine_keys.contains(&k.as_str()) {
+            rest.insert(k.clone(), v.clone());
+        }
+    }
+    Ok(ModuleSpec {
+        type_name,
+        location: loc(type_node.span()),
+        params: Params::new(Node::Mapping(rest)),
+    })
+}
