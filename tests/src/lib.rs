@@ -1,0 +1,60 @@
+//! Helpers shared by Radiant's workspace-level tests: rendering a scene in
+//! process and comparing images statistically.
+
+use radiant::backend::cpu::{Progress, render};
+use radiant::extract::{Overrides, extract};
+use radiant::film::Image;
+use std::path::{Path, PathBuf};
+
+/// The workspace root.
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Renders the scene file `scene` (relative to the workspace root) with the
+/// built-in modules.
+pub fn render_scene(scene: &str, overrides: Overrides) -> Image {
+    let scene = radiant::scene::load(root().join(scene)).expect("scene loads");
+    let r = extract(&scene, &radiant::builtin_registry(), &overrides).expect("scene extracts");
+    render(&r, &Progress::none()).image
+}
+
+/// Mean of each colour channel.
+pub fn channel_means(image: &Image) -> [f64; 3] {
+    let mut m = [0.0f64; 3];
+    for p in &image.pixels {
+        for (c, v) in m.iter_mut().enumerate() {
+            *v += p[c] as f64;
+        }
+    }
+    m.map(|v| v / image.pixels.len() as f64)
+}
+
+/// The result of comparing a render with a converged reference.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReferenceCheck {
+    /// Largest |mean(render)/mean(reference) − 1| over the colour channels.
+    pub worst_channel_mean_error: f64,
+    /// Largest relative difference of a block mean.
+    pub worst_block_error: f64,
+}
+
+/// Compares `image` with `reference` by channel means and by the means of
+/// `block`×`block` pixel blocks.
+pub fn check_against(image: &Image, reference: &Image, block: u32) -> ReferenceCheck {
+    assert_eq!((image.width, image.height), (reference.width, reference.height));
+    let (a, b) = (channel_means(image), channel_means(reference));
+    let worst_channel_mean_error = (0..3).map(|c| (a[c] / b[c] - 1.0).abs()).fold(0.0, f64::max);
+    let ba = radiant::compare::block_means(image, block);
+    let bb = radiant::compare::block_means(reference, block);
+    let worst_block_error = ba
+        .iter()
+        .zip(&bb)
+        .filter(|(_, r)| **r > 1e-3)
+        .map(|(x, r)| (x / r - 1.0).abs())
+        .fold(0.0, f64::max);
+    ReferenceCheck {
+        worst_channel_mean_error,
+        worst_block_error,
+    }
+}
