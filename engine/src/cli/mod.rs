@@ -41,6 +41,11 @@ enum Command {
 /// diagnostics and give a non-zero exit status.
 pub fn run() -> ExitCode {
     let cli = Cli::parse();
+    // Keep each message on one line so `file:line:column` stays greppable.
+    miette::set_hook(Box::new(|_| {
+        Box::new(miette::MietteHandlerOpts::new().wrap_lines(false).build())
+    }))
+    .ok();
     let registry = radiant::builtin_registry();
     let result = match cli.command {
         Command::Render(args) => render::run(&registry, &args),

@@ -1,0 +1,160 @@
+//! The `radiant` command line, end to end.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn radiant(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_radiant"))
+        .args(args)
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .output()
+        .expect("radiant runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn temp(name: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(name);
+    (dir, path)
+}
+
+#[test]
+fn renders_the_default_scene_to_png_and_exr() {
+    for ext in ["png", "exr"] {
+        let (_dir, out) = temp(&format!("cornell.{ext}"));
+        let o = radiant(&[
+            "render",
+            "scenes/cornell-box.yaml",
+            "-o",
+            out.to_str().unwrap(),
+            "--spp",
+            "2",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--threads",
+            "2",
+            "--seed",
+            "3",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let last = stderr(&o).lines().last().unwrap_or_default().to_string();
+        let pattern = regex_like(&last);
+        assert!(pattern, "summary line malformed: {last}");
+        assert!(last.starts_with("rendered 64x48, 2 spp in "), "{last}");
+        assert!(out.exists());
+    }
+}
+
+/// Checks `rendered WxH, N spp in T s (X Msamples/s, Y Mrays/s)`.
+fn regex_like(line: &str) -> bool {
+    let Some(rest) = line.strip_prefix("rendered ") else { return false };
+    let parts: Vec<&str> = rest.split_whitespace().collect();
+    parts.len() == 10
+        && parts[0].ends_with(',')
+        && parts[1].parse::<u32>().is_ok()
+        && parts[2] == "spp"
+        && parts[3] == "in"
+        && parts[4].parse::<f64>().is_ok()
+        && parts[5] == "s"
+        && parts[6].trim_start_matches('(').parse::<f64>().is_ok()
+        && parts[7] == "Msamples/s,"
+        && parts[8].parse::<f64>().is_ok()
+        && parts[9] == "Mrays/s)"
+}
+
+#[test]
+fn a_bad_scene_fails_with_its_location_and_writes_nothing() {
+    let (dir, out) = temp("x.png");
+    let scene = dir.path().join("bad.yaml");
+    std::fs::write(&scene, "camera:\n  type: perspective\n  fov: wide\n").unwrap();
+    let o = radiant(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert!(err.contains("bad.yaml:3:8"), "{err}");
+    assert!(err.contains("expected a number"), "{err}");
+    assert!(!out.exists());
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "only the scene is there");
+}
+
+#[test]
+fn bad_arguments_are_refused_before_rendering() {
+    let (_dir, out) = temp("x.bmp");
+    let o = radiant(&["render", "scenes/cornell-box.yaml", "-o", out.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains(".png or .exr"), "{}", stderr(&o));
+    assert!(!out.exists());
+
+    let o = radiant(&["render", "scenes/cornell-box.yaml", "-o", "/nonexistent/dir/x.png"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("does not exist"), "{}", stderr(&o));
+
+    let o = radiant(&["render", "scenes/cornell-box.yaml", "-o", "x.png", "--spp", "0"]);
+    assert!(!o.status.success());
+    let o = radiant(&["render", "scenes/missing.yaml", "-o", "x.png"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("cannot read the scene file"), "{}", stderr(&o));
+    let o = radiant(&["render"]);
+    assert_eq!(o.status.code(), Some(2), "usage errors exit with 2");
+}
+
+#[test]
+fn info_reports_counts_modules_and_effects() {
+    let o = radiant(&["info", "scenes/cornell-box.yaml"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    for needle in [
+        "triangles    36",
+        "lights       1 (1 on shapes)",
+        "camera perspective",
+        "light area",
+        "filter gaussian",
+        "shader diffuse",
+        "sampler independent",
+        "AREA_LIGHTS",
+    ] {
+        assert!(out.contains(needle), "`{needle}` missing from:\n{out}");
+    }
+}
+
+#[test]
+fn modules_lists_every_type_with_parameters() {
+    let o = radiant(&["modules"]);
+    assert!(o.status.success());
+    let out = stdout(&o);
+    for needle in [
+        "cameras:", "perspective", "fov_axis", "lights:", "area", "point", "intensity", "filters:",
+        "box", "gaussian", "stddev", "shaders:", "diffuse", "reflectance", "samplers:",
+        "independent", "textures:", "constant",
+    ] {
+        assert!(out.contains(needle), "`{needle}` missing from:\n{out}");
+    }
+}
+
+#[test]
+fn compare_prints_metrics_and_rejects_size_mismatches() {
+    let (dir, a) = temp("a.exr");
+    let b = dir.path().join("b.exr");
+    for (path, w) in [(&a, "32"), (&b, "16")] {
+        let o = radiant(&[
+            "render", "scenes/cornell-box.yaml", "-o", path.to_str().unwrap(), "--spp", "1", "--width", w,
+            "--height", "16",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let o = radiant(&["compare", a.to_str().unwrap(), a.to_str().unwrap()]);
+    assert!(o.status.success());
+    let out = stdout(&o);
+    assert!(out.contains("rmse 0.000000") && out.contains("mean_ratio 1.000000"), "{out}");
+    let o = radiant(&["compare", a.to_str().unwrap(), b.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("differ in size"), "{}", stderr(&o));
+}

@@ -1,0 +1,44 @@
+//! The outside module builds, registers and renders like a built-in one.
+
+use radiant::backend::cpu::{Progress, render};
+use radiant::extract::{Overrides, extract};
+use std::path::Path;
+
+const SCENE: &str = "
+film: {width: 32, height: 32, filter: {type: box}}
+sampler: {type: independent, spp: 16}
+integrator: {type: path, max_depth: 2}
+camera: {type: perspective, fov: 40, look_at: {origin: [0, 0, 3], target: [0, 0, 0]}}
+textures:
+  stripes: {type: stripes, a: [0.9, 0.9, 0.9], b: [0.05, 0.05, 0.05], count: 2}
+materials:
+  striped: {type: diffuse, reflectance: stripes}
+shapes:
+  - {type: rectangle, material: striped}
+lights:
+  - {type: point, position: [0, 0, 2], intensity: 4}
+";
+
+#[test]
+fn outside_texture_renders() {
+    let mut registry = radiant::builtin_registry();
+    radiant_example_module::register(&mut registry);
+    let scene = radiant::scene::from_str(SCENE, Path::new("inline.yaml"), Path::new(".")).unwrap();
+    let r = extract(&scene, &registry, &Overrides::default()).unwrap();
+    assert!(r.modules.iter().any(|(_, t)| t == "stripes"));
+    let image = render(&r, &Progress::none()).image;
+    // u runs left to right across the rectangle: stripes at u < 0.5 are
+    // bright, the next half dark. Compare two columns inside the rectangle.
+    let column = |x: u32| -> f32 { (12..20).map(|y| image.pixels[(y * 32 + x) as usize].x).sum() };
+    let (left, right) = (column(12), column(19));
+    assert!(left > 5.0 * right, "left {left}, right {right}");
+}
+
+#[test]
+fn builtin_registry_does_not_know_it() {
+    let scene = radiant::scene::from_str(SCENE, Path::new("inline.yaml"), Path::new(".")).unwrap();
+    let err = extract(&scene, &radiant::builtin_registry(), &Overrides::default())
+        .err()
+        .expect("unknown type");
+    assert!(err.to_string().contains("unknown texture type `stripes`"), "{err}");
+}
