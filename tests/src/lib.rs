@@ -58,3 +58,5 @@ pub fn check_against(image: &Image, reference: &Image, block: u32) -> ReferenceC
         worst_block_error,
     }
 }
+
+pub mod chi2;

@@ -1,0 +1,153 @@
+//! Chi-square goodness-of-fit tests of sampling routines against their own
+//! densities, over a grid of directions (the method of Mitsuba 3's test
+//! suite).
+//!
+//! The sphere of directions is cut into cells of equal solid angle
+//! (uniform in cos θ and φ). The expected count of a cell is N × the
+//! integral of the density over it (midpoint rule on a finer grid); cells
+//! with an expected count below 5 are pooled. The test fails if the
+//! p-value is below `significance`, if a sample lands where the density is
+//! zero, or if the density does not integrate to the fraction of samples
+//! that succeeded.
+
+use glam::{Vec2, Vec3};
+use statrs::distribution::{ChiSquared, ContinuousCDF};
+
+/// Grid and sample-count settings.
+#[derive(Debug, Clone, Copy)]
+pub struct Chi2 {
+    /// Cells along cos θ.
+    pub theta_cells: usize,
+    /// Cells along φ.
+    pub phi_cells: usize,
+    /// Sub-cells per cell edge for integrating the density.
+    pub refine: usize,
+    /// Number of samples drawn.
+    pub samples: usize,
+    /// Rejection threshold of the p-value.
+    pub significance: f64,
+}
+
+impl Default for Chi2 {
+    fn default() -> Self {
+        Self {
+            theta_cells: 20,
+            phi_cells: 40,
+            refine: 8,
+            samples: 200_000,
+            significance: 1e-3,
+        }
+    }
+}
+
+/// A small deterministic generator of uniform numbers for the tests.
+pub struct Rng(u64);
+
+impl Rng {
+    /// A generator from a seed.
+    pub fn new(seed: u64) -> Self {
+        Self(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1)
+    }
+
+    /// A uniform number in [0, 1).
+    pub fn next(&mut self) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    /// A uniform point in [0, 1)².
+    pub fn next_2d(&mut self) -> Vec2 {
+        Vec2::new(self.next(), self.next())
+    }
+}
+
+fn cell_of(cfg: &Chi2, d: Vec3) -> usize {
+    let z = d.z.clamp(-1.0, 1.0);
+    let t = (((z + 1.0) * 0.5 * cfg.theta_cells as f32) as usize).min(cfg.theta_cells - 1);
+    let phi = d.y.atan2(d.x) + std::f32::consts::PI;
+    let p = ((phi / std::f32::consts::TAU * cfg.phi_cells as f32) as usize).min(cfg.phi_cells - 1);
+    t * cfg.phi_cells + p
+}
+
+impl Chi2 {
+    /// Runs the test on `samples` (unit directions, or `None` for a failed
+    /// sample) drawn by the routine whose solid-angle density is `pdf`.
+    pub fn run(
+        &self,
+        samples: impl IntoIterator<Item = Option<Vec3>>,
+        pdf: impl Fn(Vec3) -> f64,
+    ) -> Result<f64, String> {
+        let cells = self.theta_cells * self.phi_cells;
+        let mut observed = vec![0.0f64; cells];
+        let mut succeeded = 0usize;
+        let mut drawn = 0usize;
+        for s in samples {
+            drawn += 1;
+            let Some(d) = s else { continue };
+            if !d.is_finite() || (d.length() - 1.0).abs() > 1e-3 {
+                return Err(format!("sample {d} is not a unit direction"));
+            }
+            if pdf(d) <= 0.0 {
+                return Err(format!("sample {d} has zero density"));
+            }
+            observed[cell_of(self, d)] += 1.0;
+            succeeded += 1;
+        }
+        let n = drawn as f64;
+        let dz = 2.0 / (self.theta_cells * self.refine) as f64;
+        let dphi = std::f64::consts::TAU / (self.phi_cells * self.refine) as f64;
+        let mut expected = vec![0.0f64; cells];
+        for i in 0..self.theta_cells * self.refine {
+            let z = -1.0 + (i as f64 + 0.5) * dz;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            for j in 0..self.phi_cells * self.refine {
+                let phi = -std::f64::consts::PI + (j as f64 + 0.5) * dphi;
+                let d = Vec3::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32);
+                let c = (i / self.refine) * self.phi_cells + j / self.refine;
+                expected[c] += pdf(d) * dz * dphi * n;
+            }
+        }
+        let integral: f64 = expected.iter().sum::<f64>() / n;
+        let success = succeeded as f64 / n;
+        if (integral - success).abs() > 0.01 + 3.0 / n.sqrt() {
+            return Err(format!(
+                "the density integrates to {integral:.4} but {success:.4} of the samples succeeded"
+            ));
+        }
+        // Pool cells with small expected counts (in increasing order).
+        let mut order: Vec<usize> = (0..cells).collect();
+        order.sort_by(|&a, &b| expected[a].total_cmp(&expected[b]));
+        let (mut chi2, mut dof) = (0.0f64, 0usize);
+        let (mut pool_e, mut pool_o) = (0.0f64, 0.0f64);
+        for &c in &order {
+            if expected[c] == 0.0 {
+                if observed[c] > 0.0 {
+                    return Err(format!("{} samples in a cell of zero density", observed[c]));
+                }
+                continue;
+            }
+            if expected[c] < 5.0 || pool_e > 0.0 && pool_e < 5.0 {
+                pool_e += expected[c];
+                pool_o += observed[c];
+                continue;
+            }
+            chi2 += (observed[c] - expected[c]).powi(2) / expected[c];
+            dof += 1;
+        }
+        if pool_e > 0.0 {
+            chi2 += (pool_o - pool_e).powi(2) / pool_e;
+            dof += 1;
+        }
+        if dof < 2 {
+            return Ok(1.0);
+        }
+        let p = 1.0 - ChiSquared::new((dof - 1) as f64).map_err(|e| e.to_string())?.cdf(chi2);
+        if p < self.significance {
+            Err(format!("chi² = {chi2:.1} with {} degrees of freedom: p = {p:.2e}", dof - 1))
+        } else {
+            Ok(p)
+        }
+    }
+}
