@@ -32,7 +32,8 @@ fn reference() -> Image {
 }
 
 fn passes(check: &ReferenceCheck) -> bool {
-    check.worst_channel_mean_error < CHANNEL_MEAN_TOLERANCE && check.worst_block_error < BLOCK_TOLERANCE
+    check.worst_channel_mean_error < CHANNEL_MEAN_TOLERANCE
+        && check.worst_block_error < BLOCK_TOLERANCE
 }
 
 fn render(max_depth: Option<i32>, seed: u64) -> Image {
@@ -62,7 +63,10 @@ fn matches_mitsuba_and_the_check_catches_energy_errors() {
             ..image.clone()
         };
         let check = check_against(&scaled, &reference, BLOCK);
-        assert!(!passes(&check), "a {scale}× energy error went unnoticed: {check:?}");
+        assert!(
+            !passes(&check),
+            "a {scale}× energy error went unnoticed: {check:?}"
+        );
     }
 }
 

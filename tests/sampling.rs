@@ -13,7 +13,10 @@ use radiant_tests::chi2::{Chi2, Rng};
 
 fn diffuse(textures: &mut TextureTable) -> Box<dyn Shader> {
     let white = textures.add_constant(Rgb::ONE);
-    Box::new(radiant_shaders::Diffuse::new(white, radiant_core::Effects::empty()))
+    Box::new(radiant_shaders::Diffuse::new(
+        white,
+        radiant_core::Effects::empty(),
+    ))
 }
 
 #[test]
@@ -25,7 +28,9 @@ fn diffuse_sampling_matches_its_pdf_at_every_incidence() {
         let wo = Vec3::new((1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o);
         let n = cfg.samples;
         let mut rng = Rng::new(1);
-        let u: Vec<Vec3> = (0..n).map(|_| Vec3::new(rng.next(), rng.next(), rng.next())).collect();
+        let u: Vec<Vec3> = (0..n)
+            .map(|_| Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()))
+            .collect();
         let wos = vec![wo; n];
         let uvs = vec![Vec2::ZERO; n];
         let mut out = vec![BsdfSample::default(); n];
@@ -34,34 +39,61 @@ fn diffuse_sampling_matches_its_pdf_at_every_incidence() {
         let pdf = |wi: Vec3| {
             let mut e = [BsdfEval::default()];
             let mut ctx = ShadeContext::new(&textures);
-            shader.eval(&mut ctx, SurfaceBatch { wo: &[wo], uv: &[Vec2::ZERO] }, &[wi], &mut e);
+            shader.eval(
+                &mut ctx,
+                SurfaceBatch {
+                    wo: &[wo],
+                    uv: &[Vec2::ZERO],
+                },
+                &[wi],
+                &mut e,
+            );
             e[0].pdf as f64
         };
         let samples = out.iter().map(|s| (s.pdf > 0.0).then_some(s.wi));
-        cfg.run(samples, pdf).unwrap_or_else(|e| panic!("cos θo = {cos_o}: {e}"));
+        cfg.run(samples, pdf)
+            .unwrap_or_else(|e| panic!("cos θo = {cos_o}: {e}"));
     }
 }
 
 /// The solid-angle density of `light` towards direction `d` from `origin`,
 /// found by intersecting the light's own shape.
 fn light_pdf(light: &dyn Light, shape: &Accel, origin: Vec3, d: Vec3) -> f64 {
-    let Some(hit) = shape.intersect(origin, d, f32::INFINITY) else { return 0.0 };
+    let Some(hit) = shape.intersect(origin, d, f32::INFINITY) else {
+        return 0.0;
+    };
     let p = origin + d * hit.t;
     let n = match shape.primitives()[hit.prim as usize] {
         Primitive::Triangle(v) => (v[1] - v[0]).cross(v[2] - v[0]).normalize(),
         Primitive::Sphere(c, _) => (p - c).normalize(),
     };
     let mut e = [EmitterEval::default()];
-    light.eval_hits(&[EmitterHit { origin, p, n, primitive: 0 }], &mut e);
+    light.eval_hits(
+        &[EmitterHit {
+            origin,
+            p,
+            n,
+            primitive: 0,
+        }],
+        &mut e,
+    );
     e[0].pdf as f64
 }
 
 fn check_light(shape: EmitterShape, origin: Vec3, refine: usize) {
     let light = radiant_lights::AreaLight::new(Rgb::ONE, shape.clone()).unwrap();
-    let mut prims: Vec<Primitive> = shape.triangles.iter().map(|t| Primitive::Triangle(*t)).collect();
+    let mut prims: Vec<Primitive> = shape
+        .triangles
+        .iter()
+        .map(|t| Primitive::Triangle(*t))
+        .collect();
     prims.extend(shape.spheres.iter().map(|&(c, r)| Primitive::Sphere(c, r)));
     let (accel, _) = Accel::build(&prims, BuildQuality::Medium);
-    let cfg = Chi2 { samples: 100_000, refine, ..Chi2::default() };
+    let cfg = Chi2 {
+        samples: 100_000,
+        refine,
+        ..Chi2::default()
+    };
     let mut rng = Rng::new(9);
     let u: Vec<Vec2> = (0..cfg.samples).map(|_| rng.next_2d()).collect();
     let mut out = vec![LightSample::default(); cfg.samples];
@@ -70,13 +102,16 @@ fn check_light(shape: EmitterShape, origin: Vec3, refine: usize) {
     // point hidden behind another part of the same shape (or seen from the
     // back) is a failed sample, since it emits nothing towards `origin`.
     let samples = out.iter().map(|s| {
-        (s.pdf > 0.0).then(|| (s.p - origin).normalize()).filter(|d| {
-            accel
-                .intersect(origin, *d, f32::INFINITY)
-                .is_some_and(|h| (origin + *d * h.t - s.p).length() < 1e-3)
-        })
+        (s.pdf > 0.0)
+            .then(|| (s.p - origin).normalize())
+            .filter(|d| {
+                accel
+                    .intersect(origin, *d, f32::INFINITY)
+                    .is_some_and(|h| (origin + *d * h.t - s.p).length() < 1e-3)
+            })
     });
-    cfg.run(samples, |d| light_pdf(&light, &accel, origin, d)).unwrap();
+    cfg.run(samples, |d| light_pdf(&light, &accel, origin, d))
+        .unwrap();
 }
 
 #[test]
@@ -84,8 +119,16 @@ fn area_light_sampling_matches_its_pdf_on_triangles() {
     // A tilted quad of two unequal triangles, seen from below at an angle.
     let shape = EmitterShape {
         triangles: vec![
-            [Vec3::new(-1.0, -0.5, 1.0), Vec3::new(1.5, -0.5, 1.4), Vec3::new(1.5, 0.7, 1.4)],
-            [Vec3::new(-1.0, -0.5, 1.0), Vec3::new(1.5, 0.7, 1.4), Vec3::new(-1.0, 0.3, 1.0)],
+            [
+                Vec3::new(-1.0, -0.5, 1.0),
+                Vec3::new(1.5, -0.5, 1.4),
+                Vec3::new(1.5, 0.7, 1.4),
+            ],
+            [
+                Vec3::new(-1.0, -0.5, 1.0),
+                Vec3::new(1.5, 0.7, 1.4),
+                Vec3::new(-1.0, 0.3, 1.0),
+            ],
         ]
         .into_iter()
         .map(|[a, b, c]| [a, c, b]) // face the origin (normal towards -z)
@@ -99,7 +142,10 @@ fn area_light_sampling_matches_its_pdf_on_triangles() {
 fn area_light_sampling_matches_its_pdf_on_spheres() {
     // Close to the sphere, so it covers many cells. The density diverges at
     // the silhouette (cos → 0), so the expected counts need a fine grid.
-    let shape = EmitterShape { triangles: vec![], spheres: vec![(Vec3::new(0.1, 0.2, 1.3), 1.0)] };
+    let shape = EmitterShape {
+        triangles: vec![],
+        spheres: vec![(Vec3::new(0.1, 0.2, 1.3), 1.0)],
+    };
     check_light(shape, Vec3::ZERO, 64);
 }
 
@@ -120,15 +166,26 @@ fn the_test_rejects_a_wrong_pdf() {
     let cfg = Chi2::default();
     let n = cfg.samples;
     let mut rng = Rng::new(5);
-    let u: Vec<Vec3> = (0..n).map(|_| Vec3::new(rng.next(), rng.next(), rng.next())).collect();
+    let u: Vec<Vec3> = (0..n)
+        .map(|_| Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()))
+        .collect();
     let mut out = vec![BsdfSample::default(); n];
     let mut ctx = ShadeContext::new(&textures);
     shader.sample(
         &mut ctx,
-        SurfaceBatch { wo: &vec![Vec3::Z; n], uv: &vec![Vec2::ZERO; n] },
+        SurfaceBatch {
+            wo: &vec![Vec3::Z; n],
+            uv: &vec![Vec2::ZERO; n],
+        },
         &u,
         &mut out,
     );
-    let uniform = |d: Vec3| if d.z > 0.0 { 1.0 / std::f64::consts::TAU } else { 0.0 };
+    let uniform = |d: Vec3| {
+        if d.z > 0.0 {
+            1.0 / std::f64::consts::TAU
+        } else {
+            0.0
+        }
+    };
     assert!(cfg.run(out.iter().map(|s| Some(s.wi)), uniform).is_err());
 }

@@ -16,11 +16,16 @@ fn load(text: &str) -> Result<(), SceneError> {
 /// Asserts that `text` fails at `line` with a message containing `needles`.
 fn fails_at(text: &str, line: usize, needles: &[&str]) -> SceneError {
     let err = load(text).expect_err("the scene should be rejected");
-    let loc = err.location.unwrap_or_else(|| panic!("no location in: {err}"));
+    let loc = err
+        .location
+        .unwrap_or_else(|| panic!("no location in: {err}"));
     assert_eq!(loc.line, line, "wrong line in: {err}");
     assert!(loc.column >= 1);
     let shown = err.to_string();
-    assert!(shown.starts_with(&format!("scenes/bad.yaml:{}:{}: ", loc.line, loc.column)), "{shown}");
+    assert!(
+        shown.starts_with(&format!("scenes/bad.yaml:{}:{}: ", loc.line, loc.column)),
+        "{shown}"
+    );
     for n in needles {
         assert!(shown.contains(n), "`{n}` missing from: {shown}");
     }
@@ -29,8 +34,16 @@ fn fails_at(text: &str, line: usize, needles: &[&str]) -> SceneError {
 
 #[test]
 fn invalid_yaml_syntax() {
-    fails_at("camera: {type: perspective\nshapes: [\n", 2, &["invalid YAML", "flow mapping"]);
-    fails_at("camera:\n  type: perspective\n   fov: 3\n", 3, &["invalid YAML"]);
+    fails_at(
+        "camera: {type: perspective\nshapes: [\n",
+        2,
+        &["invalid YAML", "flow mapping"],
+    );
+    fails_at(
+        "camera:\n  type: perspective\n   fov: 3\n",
+        3,
+        &["invalid YAML"],
+    );
 }
 
 #[test]
@@ -38,7 +51,11 @@ fn unknown_module_type_lists_the_known_ones_and_suggests_the_closest() {
     let err = fails_at(
         "camera: {type: perspectiv}\n",
         1,
-        &["unknown camera type `perspectiv`", "did you mean `perspective`", "known camera types: perspective"],
+        &[
+            "unknown camera type `perspectiv`",
+            "did you mean `perspective`",
+            "known camera types: perspective",
+        ],
     );
     assert_eq!(err.location.unwrap().column, 16);
     fails_at(
@@ -54,9 +71,17 @@ fn unknown_module_type_lists_the_known_ones_and_suggests_the_closest() {
     fails_at(
         &format!("{CAMERA}shapes:\n  - type: cub\n"),
         3,
-        &["unknown shape type `cub`", "did you mean `cube`", "rectangle, cube, sphere, mesh"],
+        &[
+            "unknown shape type `cub`",
+            "did you mean `cube`",
+            "rectangle, cube, sphere, mesh",
+        ],
     );
-    fails_at(&format!("{CAMERA}integrator: {{type: bdpt}}\n"), 2, &["unknown integrator type `bdpt`", "path"]);
+    fails_at(
+        &format!("{CAMERA}integrator: {{type: bdpt}}\n"),
+        2,
+        &["unknown integrator type `bdpt`", "path"],
+    );
 }
 
 #[test]
@@ -66,25 +91,48 @@ fn unknown_or_misspelled_keys() {
         5,
         &["reflectanse", "reflectance"],
     );
-    fails_at(&format!("{CAMERA}shapse: []\n"), 2, &["unknown key `shapse`", "did you mean `shapes`"]);
+    fails_at(
+        &format!("{CAMERA}shapse: []\n"),
+        2,
+        &["unknown key `shapse`", "did you mean `shapes`"],
+    );
     fails_at(
         &format!("{CAMERA}shapes:\n  - type: cube\n    materail: m\n"),
         4,
-        &["unknown key `materail` in the shape", "did you mean `material`"],
+        &[
+            "unknown key `materail` in the shape",
+            "did you mean `material`",
+        ],
     );
     fails_at(
         "camera:\n  type: perspective\n  fov_axis: x\n  fvo: 40\n",
         4,
         &["fvo", "fov"],
     );
-    fails_at(&format!("{CAMERA}film: {{width: 64, heigth: 64}}\n"), 2, &["heigth", "height"]);
+    fails_at(
+        &format!("{CAMERA}film: {{width: 64, heigth: 64}}\n"),
+        2,
+        &["heigth", "height"],
+    );
 }
 
 #[test]
 fn wrong_value_types() {
-    fails_at("camera:\n  type: perspective\n  fov: wide\n", 3, &["expected a number"]);
-    fails_at(&format!("{CAMERA}film:\n  width: big\n"), 3, &["expected an integer"]);
-    fails_at(&format!("{CAMERA}sampler: {{type: independent, spp: -4}}\n"), 2, &["integer"]);
+    fails_at(
+        "camera:\n  type: perspective\n  fov: wide\n",
+        3,
+        &["expected a number"],
+    );
+    fails_at(
+        &format!("{CAMERA}film:\n  width: big\n"),
+        3,
+        &["expected an integer"],
+    );
+    fails_at(
+        &format!("{CAMERA}sampler: {{type: independent, spp: -4}}\n"),
+        2,
+        &["integer"],
+    );
     fails_at(
         &format!("{CAMERA}materials:\n  m: {{type: diffuse, reflectance: [1, 2]}}\n"),
         3,
@@ -95,8 +143,16 @@ fn wrong_value_types() {
         4,
         &[],
     );
-    fails_at("camera:\n  type: perspective\n  fov: 180\n", 3, &["between 0 and 180"]);
-    fails_at(&format!("{CAMERA}integrator: {{type: path, max_depth: -2}}\n"), 2, &["max_depth"]);
+    fails_at(
+        "camera:\n  type: perspective\n  fov: 180\n",
+        3,
+        &["between 0 and 180"],
+    );
+    fails_at(
+        &format!("{CAMERA}integrator: {{type: path, max_depth: -2}}\n"),
+        2,
+        &["max_depth"],
+    );
 }
 
 #[test]
@@ -111,7 +167,9 @@ fn missing_mesh_file() {
 #[test]
 fn undefined_references() {
     fails_at(
-        &format!("{CAMERA}materials:\n  white: {{type: diffuse}}\nshapes:\n  - type: cube\n    material: whte\n"),
+        &format!(
+            "{CAMERA}materials:\n  white: {{type: diffuse}}\nshapes:\n  - type: cube\n    material: whte\n"
+        ),
         6,
         &["undefined material `whte`", "did you mean `white`", "white"],
     );

@@ -56,7 +56,9 @@ fn renders_the_default_scene_to_png_and_exr() {
 
 /// Checks `rendered WxH, N spp in T s (X Msamples/s, Y Mrays/s)`.
 fn regex_like(line: &str) -> bool {
-    let Some(rest) = line.strip_prefix("rendered ") else { return false };
+    let Some(rest) = line.strip_prefix("rendered ") else {
+        return false;
+    };
     let parts: Vec<&str> = rest.split_whitespace().collect();
     parts.len() == 10
         && parts[0].ends_with(',')
@@ -76,32 +78,62 @@ fn a_bad_scene_fails_with_its_location_and_writes_nothing() {
     let (dir, out) = temp("x.png");
     let scene = dir.path().join("bad.yaml");
     std::fs::write(&scene, "camera:\n  type: perspective\n  fov: wide\n").unwrap();
-    let o = radiant(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let o = radiant(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     assert!(!o.status.success());
     let err = stderr(&o);
     assert!(err.contains("bad.yaml:3:8"), "{err}");
     assert!(err.contains("expected a number"), "{err}");
     assert!(!out.exists());
-    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "only the scene is there");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        1,
+        "only the scene is there"
+    );
 }
 
 #[test]
 fn bad_arguments_are_refused_before_rendering() {
     let (_dir, out) = temp("x.bmp");
-    let o = radiant(&["render", "scenes/cornell-box.yaml", "-o", out.to_str().unwrap()]);
+    let o = radiant(&[
+        "render",
+        "scenes/cornell-box.yaml",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     assert!(!o.status.success());
     assert!(stderr(&o).contains(".png or .exr"), "{}", stderr(&o));
     assert!(!out.exists());
 
-    let o = radiant(&["render", "scenes/cornell-box.yaml", "-o", "/nonexistent/dir/x.png"]);
+    let o = radiant(&[
+        "render",
+        "scenes/cornell-box.yaml",
+        "-o",
+        "/nonexistent/dir/x.png",
+    ]);
     assert!(!o.status.success());
     assert!(stderr(&o).contains("does not exist"), "{}", stderr(&o));
 
-    let o = radiant(&["render", "scenes/cornell-box.yaml", "-o", "x.png", "--spp", "0"]);
+    let o = radiant(&[
+        "render",
+        "scenes/cornell-box.yaml",
+        "-o",
+        "x.png",
+        "--spp",
+        "0",
+    ]);
     assert!(!o.status.success());
     let o = radiant(&["render", "scenes/missing.yaml", "-o", "x.png"]);
     assert!(!o.status.success());
-    assert!(stderr(&o).contains("cannot read the scene file"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("cannot read the scene file"),
+        "{}",
+        stderr(&o)
+    );
     let o = radiant(&["render"]);
     assert_eq!(o.status.code(), Some(2), "usage errors exit with 2");
 }
@@ -131,9 +163,24 @@ fn modules_lists_every_type_with_parameters() {
     assert!(o.status.success());
     let out = stdout(&o);
     for needle in [
-        "cameras:", "perspective", "fov_axis", "lights:", "area", "point", "intensity", "filters:",
-        "box", "gaussian", "stddev", "shaders:", "diffuse", "reflectance", "samplers:",
-        "independent", "textures:", "constant",
+        "cameras:",
+        "perspective",
+        "fov_axis",
+        "lights:",
+        "area",
+        "point",
+        "intensity",
+        "filters:",
+        "box",
+        "gaussian",
+        "stddev",
+        "shaders:",
+        "diffuse",
+        "reflectance",
+        "samplers:",
+        "independent",
+        "textures:",
+        "constant",
     ] {
         assert!(out.contains(needle), "`{needle}` missing from:\n{out}");
     }
@@ -145,15 +192,26 @@ fn compare_prints_metrics_and_rejects_size_mismatches() {
     let b = dir.path().join("b.exr");
     for (path, w) in [(&a, "32"), (&b, "16")] {
         let o = radiant(&[
-            "render", "scenes/cornell-box.yaml", "-o", path.to_str().unwrap(), "--spp", "1", "--width", w,
-            "--height", "16",
+            "render",
+            "scenes/cornell-box.yaml",
+            "-o",
+            path.to_str().unwrap(),
+            "--spp",
+            "1",
+            "--width",
+            w,
+            "--height",
+            "16",
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
     }
     let o = radiant(&["compare", a.to_str().unwrap(), a.to_str().unwrap()]);
     assert!(o.status.success());
     let out = stdout(&o);
-    assert!(out.contains("rmse 0.000000") && out.contains("mean_ratio 1.000000"), "{out}");
+    assert!(
+        out.contains("rmse 0.000000") && out.contains("mean_ratio 1.000000"),
+        "{out}"
+    );
     let o = radiant(&["compare", a.to_str().unwrap(), b.to_str().unwrap()]);
     assert!(!o.status.success());
     assert!(stderr(&o).contains("differ in size"), "{}", stderr(&o));

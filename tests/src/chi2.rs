@@ -50,7 +50,7 @@ impl Rng {
     }
 
     /// A uniform number in [0, 1).
-    pub fn next(&mut self) -> f32 {
+    pub fn uniform(&mut self) -> f32 {
         self.0 ^= self.0 << 13;
         self.0 ^= self.0 >> 7;
         self.0 ^= self.0 << 17;
@@ -59,7 +59,7 @@ impl Rng {
 
     /// A uniform point in [0, 1)².
     pub fn next_2d(&mut self) -> Vec2 {
-        Vec2::new(self.next(), self.next())
+        Vec2::new(self.uniform(), self.uniform())
     }
 }
 
@@ -143,9 +143,15 @@ impl Chi2 {
         if dof < 2 {
             return Ok(1.0);
         }
-        let p = 1.0 - ChiSquared::new((dof - 1) as f64).map_err(|e| e.to_string())?.cdf(chi2);
+        let p = 1.0
+            - ChiSquared::new((dof - 1) as f64)
+                .map_err(|e| e.to_string())?
+                .cdf(chi2);
         if p < self.significance {
-            Err(format!("chi² = {chi2:.1} with {} degrees of freedom: p = {p:.2e}", dof - 1))
+            Err(format!(
+                "chi² = {chi2:.1} with {} degrees of freedom: p = {p:.2e}",
+                dof - 1
+            ))
         } else {
             Ok(p)
         }

@@ -42,9 +42,14 @@ pub struct ReferenceCheck {
 /// Compares `image` with `reference` by channel means and by the means of
 /// `block`×`block` pixel blocks.
 pub fn check_against(image: &Image, reference: &Image, block: u32) -> ReferenceCheck {
-    assert_eq!((image.width, image.height), (reference.width, reference.height));
+    assert_eq!(
+        (image.width, image.height),
+        (reference.width, reference.height)
+    );
     let (a, b) = (channel_means(image), channel_means(reference));
-    let worst_channel_mean_error = (0..3).map(|c| (a[c] / b[c] - 1.0).abs()).fold(0.0, f64::max);
+    let worst_channel_mean_error = (0..3)
+        .map(|c| (a[c] / b[c] - 1.0).abs())
+        .fold(0.0, f64::max);
     let ba = radiant::compare::block_means(image, block);
     let bb = radiant::compare::block_means(reference, block);
     let worst_block_error = ba

@@ -2,46 +2,60 @@
 //! pbrt-v4): rays through shared edges and vertices hit exactly one of the
 //! triangles that meet there, and hits closer than the computation's
 //! rounding error are rejected.
+//!
+//! Triangles are tested four at a time ([`Tri4`], structure-of-arrays, one
+//! triangle per SIMD lane). Each lane performs exactly the operations of
+//! the one-triangle algorithm, in the same order and without fused
+//! multiply–adds, so its results are bitwise those of the scalar test and
+//! watertightness carries over. The ray's axis permutation only selects
+//! which coordinate arrays are loaded, so it costs nothing.
 
-use glam::{DVec3, Vec3};
+use glam::{BVec3A, BVec4A, Vec3, Vec3A, Vec3Swizzles, Vec4};
 
 /// Per-ray constants of the watertight test.
 #[derive(Debug, Clone, Copy)]
 pub struct RayPrep {
-    origin: Vec3,
-    kx: usize,
-    ky: usize,
-    kz: usize,
-    shear: Vec3,
+    /// The origin's coordinates along the permuted axes, in every lane.
+    origin: [Vec4; 3],
+    /// The shear constants (sx, sy, sz), in every lane.
+    shear: [Vec4; 3],
+    /// The axes that become x, y and z: z is the direction's dominant axis,
+    /// x and y follow cyclically, which keeps the triangles' winding.
+    axes: [usize; 3],
 }
 
 impl RayPrep {
     /// Prepares the ray `origin + t·dir`.
     #[inline]
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        let a = dir.abs();
-        let kz = if a.x > a.y {
-            if a.x > a.z { 0 } else { 2 }
-        } else if a.y > a.z {
-            1
-        } else {
-            2
+        let (o, d) = (Vec3A::from(origin), Vec3A::from(dir));
+        let a = d.abs();
+        // The dominant axis (the last of equal ones but the first), chosen
+        // without branches: random directions would mispredict them.
+        let x_gt_y = a.x > a.y;
+        let is_x = x_gt_y & (a.x > a.z);
+        let is_y = !x_gt_y & (a.y > a.z);
+        let kz = 2 - 2 * usize::from(is_x) - usize::from(is_y);
+        // Rotate the axes so that kz comes last: xyz, yzx or zxy.
+        let rotate = |v: Vec3A| {
+            let v = Vec3A::select(BVec3A::splat(is_y), v.zxy(), v);
+            Vec3A::select(BVec3A::splat(is_x), v.yzx(), v)
         };
-        let kx = if kz == 2 { 0 } else { kz + 1 };
-        let ky = if kx == 2 { 0 } else { kx + 1 };
-        let dz = dir[kz];
+        let (o, d) = (rotate(o), rotate(d));
+        // One vector division: the same correctly rounded quotients as
+        // three scalar ones.
+        let shear = Vec3A::new(-d.x, -d.y, 1.0) / d.z;
         Self {
-            origin,
-            kx,
-            ky,
-            kz,
-            shear: Vec3::new(-dir[kx] / dz, -dir[ky] / dz, 1.0 / dz),
+            origin: [o.x, o.y, o.z].map(Vec4::splat),
+            shear: [shear.x, shear.y, shear.z].map(Vec4::splat),
+            axes: [(kz + 1) % 3, (kz + 2) % 3, kz],
         }
     }
 }
 
-#[inline]
-fn gamma(n: i32) -> f32 {
+/// γₙ = nε/(1 − nε), the bound on the relative error of n roundings.
+#[inline(always)]
+const fn gamma(n: i32) -> f32 {
     let e = f32::EPSILON * 0.5;
     (n as f32 * e) / (1.0 - n as f32 * e)
 }
@@ -50,67 +64,179 @@ fn gamma(n: i32) -> f32 {
 /// hit with 0 < t < `tmax`.
 #[inline]
 pub fn intersect(ray: &RayPrep, v: &[Vec3; 3], tmax: f32) -> Option<(f32, f32, f32)> {
-    let (kx, ky, kz) = (ray.kx, ray.ky, ray.kz);
-    let p0 = v[0] - ray.origin;
-    let p1 = v[1] - ray.origin;
-    let p2 = v[2] - ray.origin;
-    let mut p0t = Vec3::new(p0[kx], p0[ky], p0[kz]);
-    let mut p1t = Vec3::new(p1[kx], p1[ky], p1[kz]);
-    let mut p2t = Vec3::new(p2[kx], p2[ky], p2[kz]);
-    let s = ray.shear;
-    p0t.x += s.x * p0t.z;
-    p0t.y += s.y * p0t.z;
-    p1t.x += s.x * p1t.z;
-    p1t.y += s.y * p1t.z;
-    p2t.x += s.x * p2t.z;
-    p2t.y += s.y * p2t.z;
+    Tri4::new(std::slice::from_ref(v))
+        .closest(ray, tmax)
+        .map(|h| (h.t, h.b1, h.b2))
+}
 
-    let mut e0 = p1t.x * p2t.y - p1t.y * p2t.x;
-    let mut e1 = p2t.x * p0t.y - p2t.y * p0t.x;
-    let mut e2 = p0t.x * p1t.y - p0t.y * p1t.x;
-    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
-        // Fall back to double precision on edges.
-        let (a, b, c) = (p0t.as_dvec3(), p1t.as_dvec3(), p2t.as_dvec3());
-        let cross = |p: DVec3, q: DVec3| (p.x * q.y - p.y * q.x) as f32;
-        e0 = cross(b, c);
-        e1 = cross(c, a);
-        e2 = cross(a, b);
-    }
-    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
-        return None;
-    }
-    let det = e0 + e1 + e2;
-    if det == 0.0 {
-        return None;
-    }
-    p0t.z *= s.z;
-    p1t.z *= s.z;
-    p2t.z *= s.z;
-    let t_scaled = e0 * p0t.z + e1 * p1t.z + e2 * p2t.z;
-    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < tmax * det) {
-        return None;
-    }
-    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > tmax * det) {
-        return None;
-    }
-    let inv_det = 1.0 / det;
-    let t = t_scaled * inv_det;
+/// Up to four triangles, structure-of-arrays: `v[i][axis]` holds that
+/// coordinate of vertex `i` of each triangle. Unused lanes hold NaN, which
+/// never hits.
+#[derive(Debug, Clone, Copy)]
+pub struct Tri4 {
+    v: [[Vec4; 3]; 3],
+}
 
-    // Reject hits within the rounding error of t = 0 (pbrt-v4 §6.8.7).
-    let max_zt = p0t.z.abs().max(p1t.z.abs()).max(p2t.z.abs());
-    let delta_z = gamma(3) * max_zt;
-    let max_xt = p0t.x.abs().max(p1t.x.abs()).max(p2t.x.abs());
-    let max_yt = p0t.y.abs().max(p1t.y.abs()).max(p2t.y.abs());
-    let delta_x = gamma(5) * (max_xt + max_zt);
-    let delta_y = gamma(5) * (max_yt + max_zt);
-    let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-    let max_e = e0.abs().max(e1.abs()).max(e2.abs());
-    let delta_t =
-        3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
-    if t <= delta_t {
-        return None;
+/// The nearest hit in a [`Tri4`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LaneHit {
+    /// Which triangle (0 to 3) was hit.
+    pub lane: usize,
+    /// Distance along the ray.
+    pub t: f32,
+    /// Barycentric coordinate of vertex 1.
+    pub b1: f32,
+    /// Barycentric coordinate of vertex 2.
+    pub b2: f32,
+}
+
+/// What one [`Tri4`] test found: a bit per lane hit, and per lane the
+/// distance, the edge functions of vertices 1 and 2, and 1/det.
+struct Lanes {
+    mask: u32,
+    t: Vec4,
+    e1: Vec4,
+    e2: Vec4,
+    inv_det: Vec4,
+}
+
+impl Tri4 {
+    /// Packs `tris` (at most four; the rest of the lanes stay unused).
+    pub fn new(tris: &[[Vec3; 3]]) -> Self {
+        debug_assert!(tris.len() <= 4);
+        let mut v = [[Vec4::NAN; 3]; 3];
+        for (lane, tri) in tris.iter().take(4).enumerate() {
+            for (vertex, p) in tri.iter().enumerate() {
+                for axis in 0..3 {
+                    v[vertex][axis][lane] = p[axis];
+                }
+            }
+        }
+        Self { v }
     }
-    Some((t, e1 * inv_det, e2 * inv_det))
+
+    /// The nearest hit with 0 < t < `tmax`, if any (the lowest lane among
+    /// equally near ones).
+    #[inline(always)]
+    pub fn closest(&self, ray: &RayPrep, tmax: f32) -> Option<LaneHit> {
+        let lanes = self.test(ray, tmax);
+        if lanes.mask == 0 {
+            return None;
+        }
+        let t = lanes.t.to_array();
+        let mut lane = lanes.mask.trailing_zeros() as usize;
+        let mut rest = lanes.mask & (lanes.mask - 1);
+        while rest != 0 {
+            let other = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            if t[other] < t[lane] {
+                lane = other;
+            }
+        }
+        let inv_det = lanes.inv_det[lane];
+        Some(LaneHit {
+            lane,
+            t: t[lane],
+            b1: lanes.e1[lane] * inv_det,
+            b2: lanes.e2[lane] * inv_det,
+        })
+    }
+
+    /// Whether any triangle is hit with 0 < t < `tmax`.
+    #[inline(always)]
+    pub fn any(&self, ray: &RayPrep, tmax: f32) -> bool {
+        self.test(ray, tmax).mask != 0
+    }
+
+    /// The watertight test on all four lanes.
+    #[inline(always)]
+    fn test(&self, ray: &RayPrep, tmax: f32) -> Lanes {
+        // In range by construction; `min` lets the compiler see it.
+        let [kx, ky, kz] = ray.axes.map(|k| k.min(2));
+        let [ox, oy, oz] = ray.origin;
+        let [sx, sy, sz] = ray.shear;
+        // Translate to the ray origin, permute so the ray runs along +z,
+        // and shear x and y (pbrt-v4 §6.5.3); z is scaled further below.
+        let transform = |p: &[Vec4; 3]| {
+            let z = p[kz] - oz;
+            (p[kx] - ox + sx * z, p[ky] - oy + sy * z, z)
+        };
+        let (x0, y0, z0) = transform(&self.v[0]);
+        let (x1, y1, z1) = transform(&self.v[1]);
+        let (x2, y2, z2) = transform(&self.v[2]);
+
+        let mut e0 = x1 * y2 - y1 * x2;
+        let mut e1 = x2 * y0 - y2 * x0;
+        let mut e2 = x0 * y1 - y0 * x1;
+        let zero = Vec4::ZERO;
+        let on_edge = e0.cmpeq(zero) | e1.cmpeq(zero) | e2.cmpeq(zero);
+        if on_edge.any() {
+            [e0, e1, e2] = edges_in_f64(on_edge, [x0, x1, x2], [y0, y1, y2], [e0, e1, e2]);
+        }
+        // Inside: no edge function negative while another is positive.
+        let inside = e0.min(e1).min(e2).cmpge(zero) | e0.max(e1).max(e2).cmple(zero);
+        let det = e0 + e1 + e2;
+        let (z0, z1, z2) = (z0 * sz, z1 * sz, z2 * sz);
+        let t_scaled = e0 * z0 + e1 * z1 + e2 * z2;
+        // 0 < t_scaled/det ≤ tmax, with both sides' signs flipped where
+        // det < 0 (exact). A zero (degenerate triangle, ray in its plane)
+        // or NaN determinant fails.
+        let abs_det = det.abs();
+        let t_signed = t_scaled * Vec4::ONE.copysign(det);
+        let in_range = t_signed.cmpgt(zero) & t_signed.cmple(Vec4::splat(tmax) * abs_det);
+        let mut hit = inside & in_range;
+        let mut lanes = Lanes {
+            mask: hit.bitmask(),
+            t: zero,
+            e1,
+            e2,
+            inv_det: zero,
+        };
+        if lanes.mask == 0 {
+            return lanes;
+        }
+        let inv_det = Vec4::ONE / det;
+        let t = t_scaled * inv_det;
+
+        // Reject hits within the rounding error of t = 0 (pbrt-v4 §6.8.7).
+        let g = |n| Vec4::splat(gamma(n));
+        let max_zt = z0.abs().max(z1.abs()).max(z2.abs());
+        let delta_z = g(3) * max_zt;
+        let max_xt = x0.abs().max(x1.abs()).max(x2.abs());
+        let max_yt = y0.abs().max(y1.abs()).max(y2.abs());
+        let delta_x = g(5) * (max_xt + max_zt);
+        let delta_y = g(5) * (max_yt + max_zt);
+        let delta_e =
+            Vec4::splat(2.0) * (g(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+        let max_e = e0.abs().max(e1.abs()).max(e2.abs());
+        let delta_t = Vec4::splat(3.0)
+            * (g(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e)
+            * inv_det.abs();
+        // `t < tmax` again after the division's rounding.
+        hit &= t.cmpgt(delta_t) & t.cmplt(Vec4::splat(tmax));
+        lanes.mask = hit.bitmask();
+        lanes.t = t;
+        lanes.inv_det = inv_det;
+        lanes
+    }
+}
+
+/// The edge functions recomputed in double precision on the lanes of
+/// `redo`, where one of them came out exactly zero in single precision.
+#[cold]
+#[inline(never)]
+fn edges_in_f64(redo: BVec4A, x: [Vec4; 3], y: [Vec4; 3], mut e: [Vec4; 3]) -> [Vec4; 3] {
+    let mut mask = redo.bitmask();
+    while mask != 0 {
+        let lane = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        let p = |i: usize| (f64::from(x[i][lane]), f64::from(y[i][lane]));
+        let cross = |(px, py): (f64, f64), (qx, qy): (f64, f64)| (px * qy - py * qx) as f32;
+        e[0][lane] = cross(p(1), p(2));
+        e[1][lane] = cross(p(2), p(0));
+        e[2][lane] = cross(p(0), p(1));
+    }
+    e
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@ pub struct LightTable {
     lights: Vec<Box<dyn Light>>,
     cdf: Vec<f32>,
     pmf: Vec<f32>,
+    delta: Vec<bool>,
 }
 
 impl LightTable {
@@ -39,7 +40,13 @@ impl LightTable {
         if let Some(last) = cdf.last_mut() {
             *last = 1.0;
         }
-        Self { lights, cdf, pmf }
+        let delta = lights.iter().map(|l| l.is_delta()).collect();
+        Self {
+            lights,
+            cdf,
+            pmf,
+            delta,
+        }
     }
 
     /// The lights.
@@ -73,6 +80,12 @@ impl LightTable {
             0.0
         };
         (i, p, rescaled)
+    }
+
+    /// Whether light `i` is a delta light (cannot be hit, no MIS).
+    #[inline]
+    pub fn is_delta(&self, i: usize) -> bool {
+        self.delta[i]
     }
 
     /// Probability of choosing light `i`.

@@ -136,11 +136,11 @@ impl TileFilm {
         let v = value.extend(1.0);
         for y in py0..=py1 {
             let dy = y as f32 + 0.5 - pos.y;
-            let row = ((y - self.y0) * self.width - self.x0) as usize;
+            let row = &mut self.sums[((y - self.y0) * self.width) as usize..];
             for x in px0..=px1 {
                 let w = table.weight(x as f32 + 0.5 - pos.x, dy);
                 if w != 0.0 {
-                    self.sums[row + x as usize] += v * w;
+                    row[(x - self.x0) as usize] += v * w;
                 }
             }
         }

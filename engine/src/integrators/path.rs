@@ -70,6 +70,7 @@ pub struct Wavefront {
     live: Vec<u32>,
     next_live: Vec<u32>,
     scratch: Vec<u32>,
+    cursor: Vec<u32>,
     offsets: Vec<u32>,
     // Per live path in material order (index k).
     ids_k: Vec<SampleId>,
@@ -260,6 +261,7 @@ impl Wavefront {
         sort_by_key(
             &mut self.em_slots,
             &mut self.scratch,
+            &mut self.cursor,
             &mut self.offsets,
             nlights,
             |slot| surfaces.emitter[hits[slot as usize].prim as usize],
@@ -307,6 +309,7 @@ impl Wavefront {
         sort_by_key(
             &mut self.live,
             &mut self.scratch,
+            &mut self.cursor,
             &mut self.offsets,
             scene.shaders.len(),
             |slot| surfaces.material[hits[slot as usize].prim as usize],
@@ -346,6 +349,7 @@ impl Wavefront {
         sort_by_key(
             &mut self.by_light,
             &mut self.scratch,
+            &mut self.cursor,
             offsets,
             scene.lights.len(),
             |k| lights[k as usize],
@@ -439,7 +443,7 @@ impl Wavefront {
                 continue;
             }
             let light_pdf = self.light_prob[k] * ls.pdf;
-            let delta = scene.lights.lights()[self.light[k] as usize].is_delta();
+            let delta = scene.lights.is_delta(self.light[k] as usize);
             let w = if delta {
                 1.0
             } else {
@@ -493,7 +497,7 @@ impl Wavefront {
             }
             let mut beta = self.beta[i] * s.weight;
             let beta_max = beta.max_element();
-            if !(beta_max > 0.0) || !beta.is_finite() {
+            if beta_max <= 0.0 || !beta.is_finite() {
                 continue;
             }
             if rr {

@@ -3,9 +3,11 @@
 
 /// Reorders `items` by `key(item)` (stable), given `keys` distinct keys, and
 /// writes into `offsets` the start of each key's range (length `keys + 1`).
+/// `scratch` and `cursor` are reusable buffers.
 pub(crate) fn sort_by_key(
     items: &mut Vec<u32>,
     scratch: &mut Vec<u32>,
+    cursor: &mut Vec<u32>,
     offsets: &mut Vec<u32>,
     keys: usize,
     key: impl Fn(u32) -> u32,
@@ -23,11 +25,12 @@ pub(crate) fn sort_by_key(
     }
     scratch.clear();
     scratch.resize(items.len(), 0);
-    let mut next = offsets[..keys].to_vec();
+    cursor.clear();
+    cursor.extend_from_slice(&offsets[..keys]);
     for &i in items.iter() {
         let k = key(i) as usize;
-        scratch[next[k] as usize] = i;
-        next[k] += 1;
+        scratch[cursor[k] as usize] = i;
+        cursor[k] += 1;
     }
     std::mem::swap(items, scratch);
 }
@@ -40,10 +43,15 @@ mod tests {
     fn sorts_stably_and_reports_ranges() {
         let keys = [2u32, 0, 1, 2, 0, 1, 1];
         let mut items: Vec<u32> = (0..7).collect();
-        let (mut scratch, mut offsets) = (Vec::new(), Vec::new());
-        sort_by_key(&mut items, &mut scratch, &mut offsets, 3, |i| {
-            keys[i as usize]
-        });
+        let (mut scratch, mut cursor, mut offsets) = (Vec::new(), Vec::new(), Vec::new());
+        sort_by_key(
+            &mut items,
+            &mut scratch,
+            &mut cursor,
+            &mut offsets,
+            3,
+            |i| keys[i as usize],
+        );
         assert_eq!(items, [1, 4, 2, 5, 6, 0, 3]);
         assert_eq!(offsets, [0, 2, 5, 7]);
     }

@@ -27,7 +27,11 @@ impl Texture for Stripes {
     fn eval(&self, uv: &[Vec2], out: &mut [Rgb]) {
         for (uv, o) in uv.iter().zip(out.iter_mut()) {
             let stripe = (uv.x * self.count).floor() as i64;
-            *o = if stripe.rem_euclid(2) == 0 { self.a } else { self.b };
+            *o = if stripe.rem_euclid(2) == 0 {
+                self.a
+            } else {
+                self.b
+            };
         }
     }
 
@@ -54,9 +58,24 @@ fn two() -> f32 {
 }
 
 const DOCS: &[ParamDoc] = &[
-    ParamDoc { name: "a", ty: "rgb", default: "required", doc: "Colour of even stripes." },
-    ParamDoc { name: "b", ty: "rgb", default: "required", doc: "Colour of odd stripes." },
-    ParamDoc { name: "count", ty: "number", default: "2", doc: "Stripes across u ∈ [0, 1]." },
+    ParamDoc {
+        name: "a",
+        ty: "rgb",
+        default: "required",
+        doc: "Colour of even stripes.",
+    },
+    ParamDoc {
+        name: "b",
+        ty: "rgb",
+        default: "required",
+        doc: "Colour of odd stripes.",
+    },
+    ParamDoc {
+        name: "count",
+        ty: "number",
+        default: "2",
+        doc: "Stripes across u ∈ [0, 1].",
+    },
 ];
 
 /// Registers the `stripes` texture.
@@ -69,7 +88,11 @@ pub fn register(registry: &mut Registry) {
         },
         |params: &Params, _| {
             let p: StripesParams = params.parse()?;
-            Ok(Box::new(Stripes { a: p.a.0, b: p.b.0, count: p.count }) as Box<dyn Texture>)
+            Ok(Box::new(Stripes {
+                a: p.a.0,
+                b: p.b.0,
+                count: p.count,
+            }) as Box<dyn Texture>)
         },
     );
 }

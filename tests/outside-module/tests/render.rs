@@ -29,7 +29,11 @@ fn outside_texture_renders() {
     let image = render(&r, &Progress::none()).image;
     // u runs left to right across the rectangle: stripes at u < 0.5 are
     // bright, the next half dark. Compare two columns inside the rectangle.
-    let column = |x: u32| -> f32 { (12..20).map(|y| image.pixels[(y * 32 + x) as usize].x).sum() };
+    let column = |x: u32| -> f32 {
+        (12..20)
+            .map(|y| image.pixels[(y * 32 + x) as usize].x)
+            .sum()
+    };
     let (left, right) = (column(12), column(19));
     assert!(left > 5.0 * right, "left {left}, right {right}");
 }
@@ -40,5 +44,8 @@ fn builtin_registry_does_not_know_it() {
     let err = extract(&scene, &radiant::builtin_registry(), &Overrides::default())
         .err()
         .expect("unknown type");
-    assert!(err.to_string().contains("unknown texture type `stripes`"), "{err}");
+    assert!(
+        err.to_string().contains("unknown texture type `stripes`"),
+        "{err}"
+    );
 }

@@ -1,0 +1,508 @@
+//! The wide BVH that rays traverse.
+//!
+//! obvhs builds a binary BVH (PLOC with reinsertion and SAH leaf
+//! collapsing); [`Bvh4::build`] collapses it into nodes of up to eight
+//! children whose boxes are stored structure-of-arrays, so that one node is
+//! tested against a ray with SIMD, four lanes at a time (glam's `Vec4`: SSE
+//! on x86_64, a scalar fallback elsewhere). A leaf is a range of items
+//! (packets of primitives) that the caller stores.
+//!
+//! Traversal intersects a node's leaves as soon as the node is visited and
+//! keeps only inner nodes on its stack, so each step is one box test and no
+//! branch has to guess whether the next entry is a leaf.
+//!
+//! Box tests follow Ize's "Robust BVH Ray Traversal" (2013): the far
+//! distance is enlarged by the worst-case rounding error of the slab test,
+//! so a box never misses a ray that touches it, flat boxes (axis-aligned
+//! triangles) included.
+
+use glam::{Vec3, Vec3A, Vec4};
+use obvhs::aabb::Aabb;
+use obvhs::bvh2::Bvh2;
+use std::mem::MaybeUninit;
+use std::ops::Range;
+
+/// Children per node.
+const WIDTH: usize = 8;
+
+/// SIMD groups of four lanes per node.
+const GROUPS: usize = WIDTH / 4;
+
+/// Node levels at most; a subtree deeper than this becomes one leaf (only
+/// degenerate inputs get there), which bounds the traversal stack.
+const MAX_DEPTH: usize = 48;
+
+/// Traversal stack entries needed at most: a node pushes at most `WIDTH`
+/// children and pops one.
+const STACK_SIZE: usize = (WIDTH - 1) * MAX_DEPTH + 1;
+
+/// `1 + 2γ₃`: enlarging a slab test's far distance by this factor covers
+/// its rounding error.
+const FAR_SCALE: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+
+/// A node: up to eight child boxes and what each child is.
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
+struct Node {
+    /// `bounds[0][axis]` holds the children's minimum coordinates along
+    /// `axis`, four lanes per group; `bounds[1]` the maximum. Unused lanes
+    /// hold an empty box (min +∞, max −∞), which no ray hits.
+    bounds: [[[Vec4; GROUPS]; 3]; 2],
+    /// Per child: a node index, or the first item of a leaf.
+    child: [u32; WIDTH],
+    /// Per child: the number of items of a leaf (unused for nodes).
+    count: [u32; WIDTH],
+    /// Bit `lane` is set where the child is a leaf.
+    leaves: u32,
+}
+
+impl Node {
+    const EMPTY: Node = Node {
+        bounds: [
+            [[Vec4::INFINITY; GROUPS]; 3],
+            [[Vec4::NEG_INFINITY; GROUPS]; 3],
+        ],
+        child: [0; WIDTH],
+        count: [0; WIDTH],
+        leaves: 0,
+    };
+
+    /// Makes `lane` the child with box `aabb`: node `child`, or a leaf of
+    /// `count` items from `child` on.
+    fn set_lane(&mut self, lane: usize, aabb: &Aabb, child: u32, leaf: Option<u32>) {
+        for axis in 0..3 {
+            self.bounds[0][axis][lane / 4][lane % 4] = aabb.min[axis];
+            self.bounds[1][axis][lane / 4][lane % 4] = aabb.max[axis];
+        }
+        self.child[lane] = child;
+        if let Some(count) = leaf {
+            self.count[lane] = count;
+            self.leaves |= 1 << lane;
+        }
+    }
+
+    /// The item range of leaf `lane`.
+    #[inline(always)]
+    fn items(&self, lane: usize) -> Range<usize> {
+        let first = self.child[lane] as usize;
+        first..first + self.count[lane] as usize
+    }
+}
+
+/// An inner node waiting on the traversal stack, with the distance at which
+/// the ray enters its box.
+#[derive(Debug, Clone, Copy)]
+struct Entry {
+    node: u32,
+    t: f32,
+}
+
+/// A fixed-capacity stack of entries that lives on the call stack and is
+/// not initialised up front (a ray touches only its first few slots).
+struct Stack {
+    items: [MaybeUninit<Entry>; STACK_SIZE],
+    len: usize,
+}
+
+impl Stack {
+    #[inline(always)]
+    fn new() -> Self {
+        Self {
+            items: [const { MaybeUninit::uninit() }; STACK_SIZE],
+            len: 0,
+        }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, e: Entry) {
+        // Panics rather than overflowing; `MAX_DEPTH` rules that out.
+        self.items[self.len].write(e);
+        self.len += 1;
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<Entry> {
+        self.len = self.len.checked_sub(1)?;
+        // SAFETY: slots below `len` were written by `push`.
+        Some(unsafe { self.items[self.len].assume_init() })
+    }
+
+    /// Pushes `e` among the entries from `base` up, which are sorted by
+    /// decreasing distance, keeping them sorted.
+    #[inline(always)]
+    fn push_sorted(&mut self, base: usize, e: Entry) {
+        let mut i = self.len;
+        self.push(e);
+        while i > base {
+            // SAFETY: slots below `len` were written by `push`.
+            let below = unsafe { self.items[i - 1].assume_init() };
+            if below.t >= e.t {
+                break;
+            }
+            self.items[i].write(below);
+            i -= 1;
+        }
+        self.items[i].write(e);
+    }
+}
+
+/// Per-ray constants of the box test.
+#[derive(Debug, Clone, Copy)]
+pub struct RayBoxes {
+    origin: [Vec4; 3],
+    inv_dir: [Vec4; 3],
+    /// Per axis: which of `Node::bounds` the ray meets first (0: minimum).
+    near: [usize; 3],
+}
+
+impl RayBoxes {
+    /// Prepares the ray `origin + t·dir`.
+    #[inline]
+    pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        // A zero component would give 0·∞ = NaN for a box face through the
+        // origin; the smallest normal float gives a huge finite inverse.
+        let tiny = Vec3A::splat(f32::MIN_POSITIVE);
+        let dir = Vec3A::from(dir);
+        let safe = Vec3A::select(dir.abs().cmplt(tiny), tiny.copysign(dir), dir);
+        let inv_dir = Vec3A::ONE / safe;
+        let negative = inv_dir.cmplt(Vec3A::ZERO).bitmask() as usize;
+        Self {
+            origin: [origin.x, origin.y, origin.z].map(Vec4::splat),
+            inv_dir: [inv_dir.x, inv_dir.y, inv_dir.z].map(Vec4::splat),
+            near: [negative & 1, (negative >> 1) & 1, negative >> 2],
+        }
+    }
+
+    /// Which children of `node` the ray meets for t in (0, `tmax`): a bit
+    /// mask, and the distances at which it enters their boxes.
+    #[inline(always)]
+    fn test(&self, node: &Node, tmax: f32) -> (u32, [f32; WIDTH]) {
+        let mut mask = 0;
+        let mut t = [0.0; WIDTH];
+        for g in 0..GROUPS {
+            let mut t_near = Vec4::ZERO;
+            let mut t_far = Vec4::splat(tmax);
+            for axis in 0..3 {
+                let near = self.near[axis] & 1;
+                let lo = (node.bounds[near][axis][g] - self.origin[axis]) * self.inv_dir[axis];
+                let hi = (node.bounds[near ^ 1][axis][g] - self.origin[axis]) * self.inv_dir[axis];
+                t_near = t_near.max(lo);
+                t_far = t_far.min(hi);
+            }
+            mask |= t_near.cmple(t_far * FAR_SCALE).bitmask() << (4 * g);
+            t_near.write_to_slice(&mut t[4 * g..4 * g + 4]);
+        }
+        (mask, t)
+    }
+}
+
+/// A wide BVH; its leaves are ranges of items stored elsewhere.
+#[derive(Debug, Clone, Default)]
+pub struct Bvh4 {
+    nodes: Vec<Node>,
+}
+
+impl Bvh4 {
+    /// Collapses `bvh2` into a wide BVH with the least SAH cost. `leaf`
+    /// receives the primitives (as indices into `bvh2`'s input) of each
+    /// leaf, stores them, and returns the range of items that traversal
+    /// hands back for that leaf.
+    pub fn build(bvh2: &Bvh2, mut leaf: impl FnMut(&[u32]) -> Range<u32>) -> Self {
+        if bvh2.nodes.is_empty() {
+            return Self::default();
+        }
+        let plan = Collapse::new(bvh2);
+        let mut nodes = vec![Node::EMPTY];
+        let mut prims = Vec::new();
+        let mut make_leaf = |node: &mut Node, lane: usize, binary: usize| {
+            prims.clear();
+            push_primitives(bvh2, binary, &mut prims);
+            let range = leaf(&prims);
+            if !range.is_empty() {
+                let aabb = bvh2.nodes[binary].aabb();
+                node.set_lane(lane, aabb, range.start, Some(range.len() as u32));
+            }
+        };
+        if bvh2.nodes[0].is_leaf() {
+            // A single leaf: one lane of the root holds it.
+            make_leaf(&mut nodes[0], 0, 0);
+            return Self { nodes };
+        }
+        // (binary node, wide node it becomes, depth of that wide node)
+        let mut work = vec![(0, 0, 1)];
+        let mut children = Vec::with_capacity(WIDTH);
+        while let Some((binary, wide, depth)) = work.pop() {
+            children.clear();
+            plan.children(binary, &mut children);
+            for (lane, &(c, is_leaf)) in children.iter().enumerate() {
+                if is_leaf || depth >= MAX_DEPTH {
+                    make_leaf(&mut nodes[wide], lane, c);
+                } else {
+                    let index = nodes.len();
+                    nodes.push(Node::EMPTY);
+                    nodes[wide].set_lane(lane, bvh2.nodes[c].aabb(), index as u32, None);
+                    work.push((c, index, depth + 1));
+                }
+            }
+        }
+        Self { nodes }
+    }
+
+    #[cfg(test)]
+    pub fn dump(&self) {
+        for (i, n) in self.nodes.iter().enumerate() {
+            let lanes: Vec<String> = (0..WIDTH)
+                .filter(|&l| n.bounds[0][0][l / 4][l % 4].is_finite())
+                .map(|l| {
+                    let lo = [0, 1, 2].map(|a| n.bounds[0][a][l / 4][l % 4]);
+                    let hi = [0, 1, 2].map(|a| n.bounds[1][a][l / 4][l % 4]);
+                    if n.leaves >> l & 1 == 1 {
+                        format!("leaf[{}+{}] {:?}-{:?}", n.child[l], n.count[l], lo, hi)
+                    } else {
+                        format!("node {} {:?}-{:?}", n.child[l], lo, hi)
+                    }
+                })
+                .collect();
+            println!("node {i}:\n  {}", lanes.join("\n  "));
+        }
+    }
+
+    /// Whether the BVH holds no primitives.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// Visits the leaves that `ray` may hit in (0, `tmax`), inner nodes
+    /// nearest first. `leaf` intersects a leaf's items and returns the new
+    /// `tmax` (the closest hit so far); boxes beyond it are skipped.
+    #[inline(always)]
+    pub fn closest(
+        &self,
+        ray: &RayBoxes,
+        mut tmax: f32,
+        mut leaf: impl FnMut(Range<usize>, f32) -> f32,
+    ) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let mut stack = Stack::new();
+        let mut current = 0;
+        loop {
+            let node = &self.nodes[current];
+            let (mask, t_near) = ray.test(node, tmax);
+            // Leaves nearest first, until the next one starts beyond the hit.
+            let mut leaves = mask & node.leaves;
+            while leaves != 0 {
+                let mut lane = leaves.trailing_zeros() as usize;
+                let mut rest = leaves & (leaves - 1);
+                while rest != 0 {
+                    let other = rest.trailing_zeros() as usize;
+                    rest &= rest - 1;
+                    if t_near[other] < t_near[lane] {
+                        lane = other;
+                    }
+                }
+                if t_near[lane] > tmax * FAR_SCALE {
+                    break;
+                }
+                leaves &= !(1 << lane);
+                tmax = leaf(node.items(lane), tmax);
+            }
+            let mut inner = mask & !node.leaves;
+            let base = stack.len;
+            while inner != 0 {
+                let lane = inner.trailing_zeros() as usize;
+                inner &= inner - 1;
+                stack.push_sorted(
+                    base,
+                    Entry {
+                        node: node.child[lane],
+                        t: t_near[lane],
+                    },
+                );
+            }
+            // Next: the nearest pending node that is not beyond the hit.
+            loop {
+                let Some(e) = stack.pop() else { return };
+                if e.t <= tmax * FAR_SCALE {
+                    current = e.node as usize;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Visits the leaves that `ray` may hit in (0, `tmax`) until `leaf`
+    /// (which intersects a leaf's items) reports a hit; returns whether one
+    /// did.
+    #[inline(always)]
+    pub fn any(
+        &self,
+        ray: &RayBoxes,
+        tmax: f32,
+        mut leaf: impl FnMut(Range<usize>) -> bool,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let mut stack = Stack::new();
+        let mut current = 0;
+        loop {
+            let node = &self.nodes[current];
+            let (mask, _) = ray.test(node, tmax);
+            let mut leaves = mask & node.leaves;
+            while leaves != 0 {
+                let lane = leaves.trailing_zeros() as usize;
+                leaves &= leaves - 1;
+                if leaf(node.items(lane)) {
+                    return true;
+                }
+            }
+            let mut inner = mask & !node.leaves;
+            while inner != 0 {
+                let lane = inner.trailing_zeros() as usize;
+                inner &= inner - 1;
+                stack.push(Entry {
+                    node: node.child[lane],
+                    t: 0.0,
+                });
+            }
+            match stack.pop() {
+                Some(e) => current = e.node as usize,
+                None => return false,
+            }
+        }
+    }
+}
+
+/// SAH cost of visiting a node (testing the ray against its boxes),
+/// relative to testing a packet of four triangles.
+const NODE_COST: f32 = 1.0;
+
+/// Primitives per leaf at most (two packets).
+const MAX_LEAF_PRIMS: u32 = 8;
+
+/// The cheapest way to collapse a binary BVH into `WIDTH`-wide nodes, by
+/// dynamic programming over its subtrees (Ylitie et al., "Efficient
+/// Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", 2017,
+/// with the cost model of this traversal).
+struct Collapse<'a> {
+    bvh2: &'a Bvh2,
+    /// Per binary node and `i` in 0..WIDTH: how it is best represented by
+    /// at most `i + 1` children of a wide node: 0 as one child, `k` as the
+    /// best `k` children from its first child and the rest from its second.
+    split: Vec<[u8; WIDTH]>,
+    /// Per binary node: whether, as one child, it is a leaf (else a node).
+    as_leaf: Vec<bool>,
+    /// Per inner binary node: as a wide node, how many of its children
+    /// come from its first child (the rest from the second).
+    node_split: Vec<u8>,
+}
+
+impl<'a> Collapse<'a> {
+    fn new(bvh2: &'a Bvh2) -> Self {
+        let n = bvh2.nodes.len();
+        // Children before parents: the reverse of a preorder.
+        let mut order = Vec::with_capacity(n);
+        let mut pending = vec![0];
+        while let Some(i) = pending.pop() {
+            order.push(i);
+            let node = &bvh2.nodes[i];
+            if !node.is_leaf() {
+                let first = node.first_index as usize;
+                pending.extend([first, first + 1]);
+            }
+        }
+        let mut cost = vec![[0.0f32; WIDTH]; n];
+        let mut split = vec![[0u8; WIDTH]; n];
+        let mut as_leaf = vec![true; n];
+        let mut node_split = vec![1u8; n];
+        let mut prims = vec![0u32; n];
+        for &i in order.iter().rev() {
+            let node = &bvh2.nodes[i];
+            let area = node.aabb().half_area();
+            let packets = |count: u32| count.div_ceil(4) as f32;
+            if node.is_leaf() {
+                prims[i] = node.prim_count;
+                cost[i] = [area * packets(node.prim_count); WIDTH];
+                continue;
+            }
+            let (l, r) = (node.first_index as usize, node.first_index as usize + 1);
+            prims[i] = prims[l] + prims[r];
+            // Best split of `slots` children between the two subtrees.
+            let (left, right) = (cost[l], cost[r]);
+            let best_split = |slots: usize| {
+                (1..slots)
+                    .map(|k| (left[k - 1] + right[slots - k - 1], k as u8))
+                    .min_by(|a, b| a.0.total_cmp(&b.0))
+                    .unwrap_or((f32::INFINITY, 0))
+            };
+            let (children_cost, k) = best_split(WIDTH);
+            node_split[i] = k;
+            let as_node = area * NODE_COST + children_cost;
+            let as_one_leaf = if prims[i] <= MAX_LEAF_PRIMS {
+                area * packets(prims[i])
+            } else {
+                f32::INFINITY
+            };
+            as_leaf[i] = as_one_leaf <= as_node;
+            cost[i][0] = as_one_leaf.min(as_node);
+            for slots in 2..=WIDTH {
+                let (c, k) = best_split(slots);
+                if c < cost[i][slots - 2] {
+                    cost[i][slots - 1] = c;
+                    split[i][slots - 1] = k;
+                } else {
+                    cost[i][slots - 1] = cost[i][slots - 2];
+                    split[i][slots - 1] = split[i][slots - 2];
+                }
+            }
+        }
+        Self {
+            bvh2,
+            split,
+            as_leaf,
+            node_split,
+        }
+    }
+
+    /// The children of the wide node that binary node `index` (an inner
+    /// node) becomes, as (binary node, whether it is a leaf).
+    fn children(&self, index: usize, out: &mut Vec<(usize, bool)>) {
+        let first = self.bvh2.nodes[index].first_index as usize;
+        let k = usize::from(self.node_split[index]);
+        self.emit(first, k, out);
+        self.emit(first + 1, WIDTH - k, out);
+    }
+
+    /// Appends the best representation of binary node `index` by at most
+    /// `slots` children.
+    fn emit(&self, index: usize, slots: usize, out: &mut Vec<(usize, bool)>) {
+        let k = usize::from(self.split[index][slots - 1]);
+        if k == 0 {
+            out.push((index, self.as_leaf[index]));
+        } else {
+            let first = self.bvh2.nodes[index].first_index as usize;
+            self.emit(first, k, out);
+            self.emit(first + 1, slots - k, out);
+        }
+    }
+}
+
+/// Appends the primitives under binary node `index` to `prims`.
+fn push_primitives(bvh2: &Bvh2, index: usize, prims: &mut Vec<u32>) {
+    // More than one node only past `MAX_DEPTH`, where a whole subtree
+    // becomes one leaf.
+    let mut pending = vec![index];
+    while let Some(i) = pending.pop() {
+        let node = &bvh2.nodes[i];
+        let first = node.first_index as usize;
+        if node.is_leaf() {
+            let range = first..first + node.prim_count as usize;
+            prims.extend_from_slice(&bvh2.primitive_indices[range]);
+        } else {
+            pending.extend([first + 1, first]);
+        }
+    }
+}
