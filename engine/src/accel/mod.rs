@@ -1,6 +1,6 @@
 //! Acceleration: the BVH over all primitives and robust ray queries.
 //!
-//! obvhs builds a binary BVH over the primitives' boxes, which [`bvh4`]
+//! obvhs builds a binary BVH over the primitives' boxes, which [`wide`]
 //! collapses into the 4-wide BVH that rays traverse. Primitives (triangles
 //! and analytic spheres) are numbered in its leaf order, so a leaf's
 //! primitives are contiguous and a hit's primitive index addresses the
@@ -12,17 +12,17 @@
 //! floating-point error ([`offset`]), which keeps self-intersection away at
 //! every scene scale without a fixed epsilon.
 
-mod bvh4;
 pub mod offset;
 pub mod sphere;
 pub mod triangle;
+mod wide;
 
-use bvh4::{Bvh4, RayBoxes};
 use glam::{Vec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use std::time::Duration;
 use triangle::{RayPrep, Tri4};
+use wide::{RayBoxes, WideBvh};
 
 /// A primitive as the intersector sees it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -108,7 +108,7 @@ enum Packet {
 
 /// A built BVH with its primitives in leaf order.
 pub struct Accel {
-    bvh: Bvh4,
+    bvh: WideBvh,
     packets: Vec<Packet>,
     prims: Vec<Primitive>,
     /// Time the build took.
@@ -130,11 +130,11 @@ impl Accel {
         let mut order = Vec::with_capacity(prims.len());
         let mut packets = Vec::new();
         let bvh = if prims.is_empty() {
-            Bvh4::default()
+            WideBvh::default()
         } else {
             let mut core_time = Duration::default();
             let bvh2 = obvhs::bvh2::builder::build_bvh2(&boxes, quality.params(), &mut core_time);
-            Bvh4::build(&bvh2, |leaf| {
+            WideBvh::build(&bvh2, |leaf| {
                 let start = packets.len() as u32;
                 // Triangles first, so that they pack into runs of four.
                 let (tris, spheres): (Vec<u32>, Vec<u32>) = leaf
@@ -187,7 +187,7 @@ impl Accel {
     /// Finds the closest hit along `origin + t·dir` for `t` in (0, `tmax`).
     #[inline]
     pub fn intersect(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Option<Hit> {
-        if self.bvh.is_empty() || tmax.is_nan() || tmax <= 0.0 {
+        if self.bvh.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return None;
         }
         // The triangle test's constants are made at the first leaf: many
@@ -235,7 +235,7 @@ impl Accel {
     /// Whether anything blocks `origin + t·dir` for `t` in (0, `tmax`).
     #[inline]
     pub fn occluded(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
-        if self.bvh.is_empty() || tmax.is_nan() || tmax <= 0.0 {
+        if self.bvh.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return false;
         }
         let mut prep = None;
@@ -249,6 +249,14 @@ impl Accel {
             })
         })
     }
+}
+
+/// Whether a query can hit anything: finite origin and direction, and a
+/// positive `tmax` (not NaN). Other rays hit nothing.
+#[inline(always)]
+fn ray_is_valid(origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+    let finite = |v: Vec3| Vec3A::from(v).is_finite();
+    finite(origin) && finite(dir) && tmax > 0.0
 }
 
 /// [`sphere::intersect`], kept out of the triangle loops so that they
@@ -335,255 +343,161 @@ mod tests {
         );
         assert!(!accel.occluded(Vec3::ZERO, Vec3::Z, f32::INFINITY));
     }
-}
-#[cfg(test)]
-mod tmp_timing {
-    use super::*;
+
     #[test]
-    fn tmp_timing() {
-        let mut s = 7u64;
-        let mut r = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+    fn single_primitive_scenes() {
+        let tri = Primitive::Triangle([Vec3::ZERO, Vec3::X, Vec3::Y]);
+        let (accel, order) = Accel::build(&[tri], BuildQuality::Medium);
+        assert_eq!(order, [0]);
+        let hit = accel.intersect(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z, f32::INFINITY);
+        assert_eq!(hit.map(|h| (h.t, h.prim)), Some((1.0, 0)));
+        assert!(accel.occluded(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z, 2.0));
+        assert!(!accel.occluded(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z, 1.0));
+
+        let (accel, _) = Accel::build(&[Primitive::Sphere(Vec3::ZERO, 1.0)], BuildQuality::Fast);
+        let hit = accel.intersect(Vec3::new(0.0, 0.0, -3.0), Vec3::Z, f32::INFINITY);
+        assert_eq!(hit.map(|h| (h.t, h.prim)), Some((2.0, 0)));
+    }
+
+    #[test]
+    fn degenerate_and_non_finite_primitives_are_never_hit() {
+        let good = Primitive::Triangle([
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(3.0, -1.0, 0.0),
+            Vec3::new(-1.0, 3.0, 0.0),
+        ]);
+        let prims = [
+            // Zero area: collinear, a repeated vertex, a point.
+            Primitive::Triangle([Vec3::ZERO, Vec3::new(0.5, 0.5, 0.5), Vec3::ONE]),
+            Primitive::Triangle([Vec3::ZERO, Vec3::ZERO, Vec3::Y]),
+            Primitive::Triangle([Vec3::splat(0.3); 3]),
+            // Needles: long and thin, in front of the good triangle.
+            Primitive::Triangle([
+                Vec3::new(0.0, 0.0, 0.5),
+                Vec3::new(1.0, 0.0, 0.5),
+                Vec3::new(0.5, 1e-7, 0.5),
+            ]),
+            Primitive::Triangle([
+                Vec3::new(0.0, 0.3, 0.6),
+                Vec3::new(1.0, 0.3, 0.6),
+                Vec3::new(0.0, 0.3, 0.6 + 1e-30),
+            ]),
+            // Not finite.
+            Primitive::Triangle([Vec3::NAN, Vec3::X, Vec3::Y]),
+            Primitive::Triangle([Vec3::INFINITY, Vec3::X, Vec3::Y]),
+            Primitive::Sphere(Vec3::new(f32::NAN, 0.0, 0.0), 1.0),
+            Primitive::Sphere(Vec3::ZERO, f32::INFINITY),
+            good,
+        ];
+        let (accel, order) = Accel::build(&prims, BuildQuality::Medium);
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..prims.len() as u32).collect::<Vec<_>>());
+        let mut s = 9;
+        for _ in 0..5000 {
+            let target = Vec3::new(lcg(&mut s), lcg(&mut s), 0.0) * 0.99;
+            let o = Vec3::new(lcg(&mut s) - 0.5, lcg(&mut s) - 0.5, 2.0);
+            let d = target - o;
+            let hit = accel.intersect(o, d, f32::INFINITY);
+            let h = hit.unwrap_or_else(|| panic!("ray to {target} missed"));
+            assert!(h.t.is_finite() && h.b1.is_finite() && h.b2.is_finite());
+            // Needles may be hit, and so may the collinear triangle (its
+            // projection is a sliver after rounding); triangles with a
+            // repeated vertex and non-finite primitives never.
+            let input = order[h.prim as usize] as usize;
+            assert!(matches!(input, 0 | 3 | 4 | 9), "hit primitive {input}");
+            if input == 9 {
+                assert!((h.t - 1.0).abs() < 1e-6);
+            }
+            assert!(accel.occluded(o, d, f32::INFINITY));
+        }
+    }
+
+    #[test]
+    fn bad_rays_hit_nothing() {
+        let (accel, _) = Accel::build(
+            &[
+                Primitive::Triangle([-Vec3::X, Vec3::X, Vec3::Y]),
+                Primitive::Sphere(Vec3::Z, 0.5),
+            ],
+            BuildQuality::Medium,
+        );
+        let (o, d) = (Vec3::new(0.0, 0.2, -1.0), Vec3::Z);
+        assert!(accel.intersect(o, d, f32::INFINITY).is_some());
+        for (o, d, tmax) in [
+            (Vec3::NAN, d, f32::INFINITY),
+            (o, Vec3::NAN, f32::INFINITY),
+            (o, Vec3::ZERO, f32::INFINITY),
+            (Vec3::INFINITY, -Vec3::ONE, f32::INFINITY),
+            (o, d, f32::NAN),
+            (o, d, 0.0),
+            (o, d, -1.0),
+        ] {
+            assert_eq!(accel.intersect(o, d, tmax), None, "{o} {d} {tmax}");
+            assert!(!accel.occluded(o, d, tmax), "{o} {d} {tmax}");
+        }
+    }
+
+    #[test]
+    fn axis_aligned_rays_find_flat_tiles_at_shared_edges() {
+        // A plane of axis-aligned unit squares (flat boxes in every node);
+        // rays straight down (two direction components zero) at every tile
+        // corner and edge midpoint must hit, whatever the BVH looks like.
+        let n = 12;
         let mut prims = Vec::new();
-        for _ in 0..36 {
-            let c = Vec3::new(r(), r(), r()) * 2.0 - 1.0;
-            let mut v = || c + (Vec3::new(r(), r(), r()) - 0.5) * 0.8;
-            prims.push(Primitive::Triangle([v(), v(), v()]));
+        for i in 0..n {
+            for j in 0..n {
+                let p = |di: i32, dj: i32| Vec3::new((i + di) as f32, (j + dj) as f32, 0.0) * 0.5;
+                prims.push(Primitive::Triangle([p(0, 0), p(1, 0), p(1, 1)]));
+                prims.push(Primitive::Triangle([p(0, 0), p(1, 1), p(0, 1)]));
+            }
         }
         let (accel, _) = Accel::build(&prims, BuildQuality::Medium);
-        let rays: Vec<(Vec3, Vec3)> = (0..1_000_000)
-            .map(|_| {
-                (
-                    Vec3::new(r(), r(), r()) * 1.8 - 0.9,
-                    (Vec3::new(r(), r(), r()) - 0.5).normalize(),
-                )
-            })
-            .collect();
-        for _ in 0..3 {
-            let t = std::time::Instant::now();
-            let mut acc = 0.0f32;
-            for (o, d) in &rays {
-                let p = RayPrep::new(*o, *d);
-                let b = RayBoxes::new(*o, *d);
-                std::hint::black_box((p, b));
-                acc += 1.0;
-            }
-            println!("prep: {:.1} ns {acc}", t.elapsed().as_secs_f64() * 1e3);
-            let t = std::time::Instant::now();
-            let mut n = 0u64;
-            for (o, d) in &rays {
-                let b = RayBoxes::new(*o, *d);
-                accel.bvh.closest(&b, f32::INFINITY, |rg, tm| {
-                    n += rg.len() as u64;
-                    tm
-                });
-            }
-            println!(
-                "traverse only: {:.1} ns ({n})",
-                t.elapsed().as_secs_f64() * 1e3
-            );
-            let t = std::time::Instant::now();
-            let mut n = 0u64;
-            for (o, d) in &rays {
-                if accel.intersect(*o, *d, f32::INFINITY).is_some() {
-                    n += 1;
-                }
-            }
-            println!("full: {:.1} ns ({n})", t.elapsed().as_secs_f64() * 1e3);
-        }
-    }
-}
-#[cfg(test)]
-mod tmp_micro {
-    use super::*;
-    #[test]
-    fn tmp_micro() {
-        let mut s = 7u64;
-        let mut r = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
-        let tris: Vec<[Vec3; 3]> = (0..4)
-            .map(|_| {
-                let c = Vec3::new(r(), r(), r()) * 2.0 - 1.0;
-                let mut v = || c + (Vec3::new(r(), r(), r()) - 0.5) * 1.5;
-                [v(), v(), v()]
-            })
-            .collect();
-        let packet = Tri4::new(&tris);
-        let rays: Vec<(Vec3, Vec3)> = (0..1000)
-            .map(|_| {
-                (
-                    Vec3::new(r(), r(), r()) * 4.0 - 2.0,
-                    (Vec3::new(r(), r(), r()) - 0.5).normalize(),
-                )
-            })
-            .collect();
-        let preps: Vec<RayPrep> = rays.iter().map(|(o, d)| RayPrep::new(*o, *d)).collect();
-        let preps: Vec<RayPrep> = (0..1000).flat_map(|_| preps.iter().copied()).collect();
-        let rays: Vec<(Vec3, Vec3)> = (0..1000).flat_map(|_| rays.iter().copied()).collect();
-        for _ in 0..3 {
-            let t = std::time::Instant::now();
-            let mut n = 0;
-            for p in preps.iter().take(1000).cycle().take(1_000_000) {
-                if packet.closest(p, f32::INFINITY).is_some() {
-                    n += 1;
-                }
-            }
-            println!(
-                "packet closest (independent rays): {:.1} ns ({n})",
-                t.elapsed().as_secs_f64() * 1e3
-            );
-            let t = std::time::Instant::now();
-            let mut n = 0;
-            for p in preps.iter().take(1000).cycle().take(1_000_000) {
-                if packet.any(p, f32::INFINITY) {
-                    n += 1;
-                }
-            }
-            println!(
-                "packet any (independent rays): {:.1} ns ({n})",
-                t.elapsed().as_secs_f64() * 1e3
-            );
-            let t = std::time::Instant::now();
-            let mut tm = 0.0f32;
-            for p in preps.iter().take(1000).cycle().take(1_000_000) {
-                tm += packet.closest(p, f32::INFINITY).map_or(0.0, |h| h.t);
-            }
-            println!(
-                "packet closest sum: {:.1} ns ({tm})",
-                t.elapsed().as_secs_f64() * 1e3
-            );
-            let t = std::time::Instant::now();
-            let mut n = 0;
-            for (o, d) in rays.iter().take(1000).cycle().take(1_000_000) {
-                let p = RayPrep::new(*o, *d);
-                if packet.any(&p, f32::INFINITY) {
-                    n += 1;
-                }
-            }
-            println!(
-                "prep+packet any: {:.1} ns ({n})",
-                t.elapsed().as_secs_f64() * 1e3
-            );
-        }
-    }
-}
-#[cfg(test)]
-mod tmp_stage {
-    use super::*;
-    #[test]
-    fn tmp_stage() {
-        let scene = crate::scene::load(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../scenes/cornell-box.yaml"
-        ))
-        .unwrap();
-        let r = crate::extract::extract(&scene, &crate::builtin_registry(), &Default::default())
-            .unwrap();
-        let a = &r.accel;
-        let mut s = 12345u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
-        let rays: Vec<(Vec3, Vec3)> = (0..1_000_000)
-            .map(|_| {
-                let o = Vec3::new(rnd() * 1.8 - 0.9, rnd() * 1.8 - 0.9, rnd() * 1.8 - 0.9)
-                    - Vec3::new(0.0, 0.0, 3.9);
-                let d = (Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5)).normalize();
-                (o, d)
-            })
-            .collect();
-        for _ in 0..3 {
-            let t = std::time::Instant::now();
-            for (o, d) in &rays {
-                std::hint::black_box((RayPrep::new(*o, *d), RayBoxes::new(*o, *d)));
-            }
-            let e0 = t.elapsed().as_secs_f64() * 1e3;
-            let t = std::time::Instant::now();
-            let mut n = 0u64;
-            for (o, d) in &rays {
-                let b = RayBoxes::new(*o, *d);
-                a.bvh.closest(&b, f32::INFINITY, |rg, tm| {
-                    n += rg.len() as u64;
-                    tm
-                });
-            }
-            let e1 = t.elapsed().as_secs_f64() * 1e3;
-            let t = std::time::Instant::now();
-            let mut n2 = 0u64;
-            for (o, d) in &rays {
-                let b = RayBoxes::new(*o, *d);
-                a.bvh.any(&b, f32::INFINITY, |rg| {
-                    n2 += rg.len() as u64;
-                    false
-                });
-            }
-            let e2 = t.elapsed().as_secs_f64() * 1e3;
-            let t = std::time::Instant::now();
-            let mut h = 0u64;
-            for (o, d) in &rays {
-                if a.intersect(*o, *d, f32::INFINITY).is_some() {
-                    h += 1;
-                }
-            }
-            let e3 = t.elapsed().as_secs_f64() * 1e3;
-            let t = std::time::Instant::now();
-            let mut h2 = 0u64;
-            for (o, d) in &rays {
-                if a.occluded(*o, *d, 0.5) {
-                    h2 += 1;
-                }
-            }
-            let e4 = t.elapsed().as_secs_f64() * 1e3;
-            let same: Vec<(Vec3, Vec3)> = vec![rays[7]; 1_000_000];
-            let t = std::time::Instant::now();
-            let mut h3 = 0u64;
-            for (o, d) in &same {
-                if a.intersect(std::hint::black_box(*o), *d, f32::INFINITY)
-                    .is_some()
-                {
-                    h3 += 1;
-                }
-            }
-            let e5 = t.elapsed().as_secs_f64() * 1e3;
-            let mut sorted = rays.clone();
-            sorted.sort_by_key(|(_, d)| {
-                (d.x > 0.0) as u8 * 4
-                    + (d.y > 0.0) as u8 * 2
-                    + (d.z > 0.0) as u8
-                    + if d.x.abs() > d.y.abs() && d.x.abs() > d.z.abs() {
-                        8
-                    } else if d.y.abs() > d.z.abs() {
-                        16
-                    } else {
-                        0
+        for i in 0..=2 * n {
+            for j in 0..=2 * n {
+                let o = Vec3::new(i as f32, j as f32, 4.0) * Vec3::new(0.25, 0.25, 1.0);
+                for d in [
+                    -Vec3::Z,
+                    Vec3::new(0.0, 1e-3, -1.0),
+                    Vec3::new(-1e-3, 0.0, -1.0),
+                ] {
+                    let target = o + d * 4.0 / -d.z;
+                    let inside = target.x >= 0.0
+                        && target.y >= 0.0
+                        && target.x <= 0.5 * n as f32
+                        && target.y <= 0.5 * n as f32;
+                    if inside {
+                        let hit = accel.intersect(o, d, f32::INFINITY);
+                        assert!(
+                            hit.is_some(),
+                            "ray down at ({}, {}) along {d} leaked",
+                            o.x,
+                            o.y
+                        );
+                        assert!(accel.occluded(o, d, f32::INFINITY));
                     }
-            });
-            let t = std::time::Instant::now();
-            let mut h4 = 0u64;
-            for (o, d) in &sorted {
-                if a.intersect(*o, *d, f32::INFINITY).is_some() {
-                    h4 += 1;
                 }
             }
-            let e6 = t.elapsed().as_secs_f64() * 1e3;
-            println!("same ray {e5:.1} ({h3}) | octant+axis sorted {e6:.1} ({h4})");
-            println!(
-                "prep {e0:.1} | trav-closest-noleaf {e1:.1} ({:.2} leaves) | trav-any-noleaf {e2:.1} ({:.2}) | full closest {e3:.1} ({h}) | occluded {e4:.1} ({h2})",
-                n as f64 / 1e6,
-                n2 as f64 / 1e6
-            );
         }
+    }
+
+    #[test]
+    fn coincident_primitives_build_a_usable_hierarchy() {
+        // Thousands of identical triangles give the builder nothing to
+        // split; traversal must stay within its stack and find them.
+        let tri = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let mut prims = vec![Primitive::Triangle(tri); 5000];
+        prims.push(Primitive::Triangle(tri.map(|v| v + Vec3::Z)));
+        let (accel, order) = Accel::build(&prims, BuildQuality::High);
+        let hit = accel.intersect(Vec3::new(0.2, 0.2, 2.0), -Vec3::Z, f32::INFINITY);
+        assert_eq!(
+            hit.map(|h| (h.t, order[h.prim as usize])),
+            Some((1.0, 5000))
+        );
+        let hit = accel.intersect(Vec3::new(0.2, 0.2, 0.5), -Vec3::Z, f32::INFINITY);
+        assert_eq!(hit.map(|h| h.t), Some(0.5));
+        assert!(accel.occluded(Vec3::new(0.2, 0.2, 0.5), -Vec3::Z, 1.0));
+        assert!(!accel.occluded(Vec3::new(0.2, 0.2, 0.5), Vec3::Z, 0.4));
     }
 }
 #[cfg(test)]
@@ -673,78 +587,5 @@ mod tmp_count {
             }
         }
         println!("{h}");
-    }
-}
-#[cfg(test)]
-mod tmp_leafstats {
-    use super::*;
-    #[test]
-    fn tmp_leafstats() {
-        let scene = crate::scene::load(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../scenes/cornell-box.yaml"
-        ))
-        .unwrap();
-        let a = crate::extract::extract(&scene, &crate::builtin_registry(), &Default::default())
-            .unwrap()
-            .accel;
-        let mut s = 12345u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
-        let mut hist = std::collections::BTreeMap::new();
-        let (mut tests, mut hits, mut leafcalls) = (0, 0, 0);
-        let n = 100000;
-        for _ in 0..n {
-            let o = Vec3::new(rnd() * 1.8 - 0.9, rnd() * 1.8 - 0.9, rnd() * 1.8 - 0.9)
-                - Vec3::new(0.0, 0.0, 3.9);
-            let d = (Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5)).normalize();
-            let prep = RayPrep::new(o, d);
-            let mut seq = Vec::new();
-            a.bvh
-                .closest(&RayBoxes::new(o, d), f32::INFINITY, |range, mut tmax| {
-                    leafcalls += 1;
-                    for (k, p) in a.packets[range.clone()].iter().enumerate() {
-                        tests += 1;
-                        if let Packet::Triangles { tris, .. } = p {
-                            if let Some(h) = tris.closest(&prep, tmax) {
-                                tmax = h.t;
-                                hits += 1;
-                                seq.push(format!("{}H", range.start + k));
-                            } else {
-                                seq.push(format!("{}", range.start + k));
-                            }
-                        }
-                    }
-                    tmax
-                });
-            *hist.entry(seq.join(",")).or_insert(0) += 1;
-        }
-        a.bvh.dump();
-        for (i, p) in a.packets.iter().enumerate() {
-            if let Packet::Triangles { first, tris } = p {
-                println!("packet {i}: first prim {first} {:?}", tris);
-            }
-        }
-        println!(
-            "tests/ray {:.2} hits/ray {:.2} leafcalls/ray {:.2}",
-            tests as f64 / n as f64,
-            hits as f64 / n as f64,
-            leafcalls as f64 / n as f64
-        );
-        let mut v: Vec<_> = hist.into_iter().collect();
-        v.sort_by_key(|x| -x.1);
-        for (k, c) in v.iter().take(25) {
-            println!("{c:6} {k}");
-        }
-        for (i, p) in a.packets.iter().enumerate() {
-            if let Packet::Triangles { first, .. } = p {
-                println!("packet {i}: first prim {first}");
-            }
-        }
-        println!("{:?}", &a.prims[..]);
     }
 }

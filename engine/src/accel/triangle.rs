@@ -26,7 +26,10 @@ pub struct RayPrep {
 
 impl RayPrep {
     /// Prepares the ray `origin + t·dir`.
-    #[inline]
+    ///
+    /// Not inlined, so that traversal really makes it only when a ray
+    /// reaches its first leaf (inlined, it gets hoisted to the start).
+    #[inline(never)]
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
         let (o, d) = (Vec3A::from(origin), Vec3A::from(dir));
         let a = d.abs();
@@ -133,12 +136,13 @@ impl Tri4 {
                 lane = other;
             }
         }
-        let inv_det = lanes.inv_det[lane];
+        // Arrays, not `Vec4` indexing (a jump table on the lane).
+        let inv_det = lanes.inv_det.to_array()[lane];
         Some(LaneHit {
             lane,
             t: t[lane],
-            b1: lanes.e1[lane] * inv_det,
-            b2: lanes.e2[lane] * inv_det,
+            b1: lanes.e1.to_array()[lane] * inv_det,
+            b2: lanes.e2.to_array()[lane] * inv_det,
         })
     }
 
@@ -254,6 +258,28 @@ mod tests {
         assert!(intersect(&miss, &tri, f32::INFINITY).is_none());
         let behind = RayPrep::new(Vec3::new(0.25, 0.25, 1.0), Vec3::Z);
         assert!(intersect(&behind, &tri, f32::INFINITY).is_none());
+    }
+
+    #[test]
+    fn packed_lanes_match_single_triangles() {
+        let mut s = 1u32;
+        let mut r = || {
+            s = s.wrapping_mul(1664525).wrapping_add(1013904223);
+            (s >> 8) as f32 / (1 << 24) as f32 - 0.5
+        };
+        for _ in 0..2000 {
+            let tris: Vec<[Vec3; 3]> = (0..4)
+                .map(|_| [(); 3].map(|_| Vec3::new(r(), r(), r())))
+                .collect();
+            let ray = RayPrep::new(Vec3::new(r(), r(), r()) * 4.0, Vec3::new(r(), r(), r()));
+            let packed = Tri4::new(&tris).closest(&ray, f32::INFINITY);
+            let single = tris
+                .iter()
+                .enumerate()
+                .filter_map(|(lane, v)| intersect(&ray, v, f32::INFINITY).map(|h| (lane, h)))
+                .min_by(|a, b| a.1.0.total_cmp(&b.1.0));
+            assert_eq!(packed.map(|h| (h.lane, (h.t, h.b1, h.b2))), single);
+        }
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! The wide BVH that rays traverse.
 //!
 //! obvhs builds a binary BVH (PLOC with reinsertion and SAH leaf
-//! collapsing); [`Bvh4::build`] collapses it into nodes of up to eight
+//! collapsing); [`WideBvh::build`] collapses it into nodes of up to eight
 //! children whose boxes are stored structure-of-arrays, so that one node is
 //! tested against a ray with SIMD, four lanes at a time (glam's `Vec4`: SSE
 //! on x86_64, a scalar fallback elsewhere). A leaf is a range of items
@@ -113,36 +113,41 @@ impl Stack {
         }
     }
 
+    /// Pushes the children of `node` in `lanes` (a bit per lane), with
+    /// their entry distances `t`; with `sorted`, so that the entries pushed
+    /// are in order of decreasing distance (the nearest is popped first).
     #[inline(always)]
-    fn push(&mut self, e: Entry) {
-        // Panics rather than overflowing; `MAX_DEPTH` rules that out.
-        self.items[self.len].write(e);
-        self.len += 1;
+    fn push_lanes(&mut self, node: &Node, mut lanes: u32, t: &[f32; WIDTH], sorted: bool) {
+        let base = self.len;
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            let e = Entry {
+                node: node.child[lane],
+                t: t[lane],
+            };
+            let mut i = self.len;
+            // Panics rather than overflowing; `MAX_DEPTH` rules that out.
+            self.items[i].write(e);
+            self.len += 1;
+            while sorted && i > base {
+                // SAFETY: slots below `len` have been written.
+                let below = unsafe { self.items[i - 1].assume_init() };
+                if below.t >= e.t {
+                    break;
+                }
+                self.items[i].write(below);
+                self.items[i - 1].write(e);
+                i -= 1;
+            }
+        }
     }
 
     #[inline(always)]
     fn pop(&mut self) -> Option<Entry> {
         self.len = self.len.checked_sub(1)?;
-        // SAFETY: slots below `len` were written by `push`.
+        // SAFETY: slots below `len` have been written.
         Some(unsafe { self.items[self.len].assume_init() })
-    }
-
-    /// Pushes `e` among the entries from `base` up, which are sorted by
-    /// decreasing distance, keeping them sorted.
-    #[inline(always)]
-    fn push_sorted(&mut self, base: usize, e: Entry) {
-        let mut i = self.len;
-        self.push(e);
-        while i > base {
-            // SAFETY: slots below `len` were written by `push`.
-            let below = unsafe { self.items[i - 1].assume_init() };
-            if below.t >= e.t {
-                break;
-            }
-            self.items[i].write(below);
-            i -= 1;
-        }
-        self.items[i].write(e);
     }
 }
 
@@ -156,15 +161,13 @@ pub struct RayBoxes {
 }
 
 impl RayBoxes {
-    /// Prepares the ray `origin + t·dir`.
+    /// Prepares the ray `origin + t·dir` (both finite).
     #[inline]
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        // A zero component would give 0·∞ = NaN for a box face through the
-        // origin; the smallest normal float gives a huge finite inverse.
-        let tiny = Vec3A::splat(f32::MIN_POSITIVE);
-        let dir = Vec3A::from(dir);
-        let safe = Vec3A::select(dir.abs().cmplt(tiny), tiny.copysign(dir), dir);
-        let inv_dir = Vec3A::ONE / safe;
+        // A zero component gives an infinite inverse: the slab test then
+        // yields ±∞, or 0·∞ = NaN for a face through the origin, which
+        // `max_of`/`min_of` drop (the ray lies in the face: no constraint).
+        let inv_dir = Vec3A::ONE / Vec3A::from(dir);
         let negative = inv_dir.cmplt(Vec3A::ZERO).bitmask() as usize;
         Self {
             origin: [origin.x, origin.y, origin.z].map(Vec4::splat),
@@ -186,8 +189,8 @@ impl RayBoxes {
                 let near = self.near[axis] & 1;
                 let lo = (node.bounds[near][axis][g] - self.origin[axis]) * self.inv_dir[axis];
                 let hi = (node.bounds[near ^ 1][axis][g] - self.origin[axis]) * self.inv_dir[axis];
-                t_near = t_near.max(lo);
-                t_far = t_far.min(hi);
+                t_near = max_of(lo, t_near);
+                t_far = min_of(hi, t_far);
             }
             mask |= t_near.cmple(t_far * FAR_SCALE).bitmask() << (4 * g);
             t_near.write_to_slice(&mut t[4 * g..4 * g + 4]);
@@ -196,13 +199,32 @@ impl RayBoxes {
     }
 }
 
+/// The larger of `new` and `acc` per lane; `acc` where `new` is NaN.
+#[inline(always)]
+fn max_of(new: Vec4, acc: Vec4) -> Vec4 {
+    // glam's SSE2 and scalar `max` are `new > acc ? new : acc` (MAXPS).
+    #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
+    return new.max(acc);
+    #[cfg(not(any(target_arch = "x86", target_arch = "x86_64")))]
+    return Vec4::select(new.cmpgt(acc), new, acc);
+}
+
+/// The smaller of `new` and `acc` per lane; `acc` where `new` is NaN.
+#[inline(always)]
+fn min_of(new: Vec4, acc: Vec4) -> Vec4 {
+    #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
+    return new.min(acc);
+    #[cfg(not(any(target_arch = "x86", target_arch = "x86_64")))]
+    return Vec4::select(new.cmplt(acc), new, acc);
+}
+
 /// A wide BVH; its leaves are ranges of items stored elsewhere.
 #[derive(Debug, Clone, Default)]
-pub struct Bvh4 {
+pub struct WideBvh {
     nodes: Vec<Node>,
 }
 
-impl Bvh4 {
+impl WideBvh {
     /// Collapses `bvh2` into a wide BVH with the least SAH cost. `leaf`
     /// receives the primitives (as indices into `bvh2`'s input) of each
     /// leaf, stores them, and returns the range of items that traversal
@@ -248,25 +270,6 @@ impl Bvh4 {
         Self { nodes }
     }
 
-    #[cfg(test)]
-    pub fn dump(&self) {
-        for (i, n) in self.nodes.iter().enumerate() {
-            let lanes: Vec<String> = (0..WIDTH)
-                .filter(|&l| n.bounds[0][0][l / 4][l % 4].is_finite())
-                .map(|l| {
-                    let lo = [0, 1, 2].map(|a| n.bounds[0][a][l / 4][l % 4]);
-                    let hi = [0, 1, 2].map(|a| n.bounds[1][a][l / 4][l % 4]);
-                    if n.leaves >> l & 1 == 1 {
-                        format!("leaf[{}+{}] {:?}-{:?}", n.child[l], n.count[l], lo, hi)
-                    } else {
-                        format!("node {} {:?}-{:?}", n.child[l], lo, hi)
-                    }
-                })
-                .collect();
-            println!("node {i}:\n  {}", lanes.join("\n  "));
-        }
-    }
-
     /// Whether the BVH holds no primitives.
     #[inline]
     pub fn is_empty(&self) -> bool {
@@ -309,19 +312,7 @@ impl Bvh4 {
                 leaves &= !(1 << lane);
                 tmax = leaf(node.items(lane), tmax);
             }
-            let mut inner = mask & !node.leaves;
-            let base = stack.len;
-            while inner != 0 {
-                let lane = inner.trailing_zeros() as usize;
-                inner &= inner - 1;
-                stack.push_sorted(
-                    base,
-                    Entry {
-                        node: node.child[lane],
-                        t: t_near[lane],
-                    },
-                );
-            }
+            stack.push_lanes(node, mask & !node.leaves, &t_near, true);
             // Next: the nearest pending node that is not beyond the hit.
             loop {
                 let Some(e) = stack.pop() else { return };
@@ -350,7 +341,7 @@ impl Bvh4 {
         let mut current = 0;
         loop {
             let node = &self.nodes[current];
-            let (mask, _) = ray.test(node, tmax);
+            let (mask, t_near) = ray.test(node, tmax);
             let mut leaves = mask & node.leaves;
             while leaves != 0 {
                 let lane = leaves.trailing_zeros() as usize;
@@ -359,15 +350,7 @@ impl Bvh4 {
                     return true;
                 }
             }
-            let mut inner = mask & !node.leaves;
-            while inner != 0 {
-                let lane = inner.trailing_zeros() as usize;
-                inner &= inner - 1;
-                stack.push(Entry {
-                    node: node.child[lane],
-                    t: 0.0,
-                });
-            }
+            stack.push_lanes(node, mask & !node.leaves, &t_near, false);
             match stack.pop() {
                 Some(e) => current = e.node as usize,
                 None => return false,
