@@ -14,12 +14,19 @@ use radiant_core::{Filter, Rgb};
 /// Entries per axis of the tabulated filter quadrant.
 const TABLE_RES: usize = 64;
 
+/// Pixels per axis a separable splat handles with its fast path (a filter
+/// radius up to 7.5 pixels); wider filters take the general path.
+const MAX_TAPS: usize = 16;
+
 /// A filter tabulated over one quadrant [0, r]² (filters are symmetric).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FilterTable {
     radius: f32,
     scale: f32,
     values: Vec<f32>,
+    /// For a separable filter f(x, y) = g(x)·g(y): g tabulated over [0, r],
+    /// so a splat computes one row and one column of weights.
+    separable: Option<Vec<f32>>,
 }
 
 impl FilterTable {
@@ -33,10 +40,12 @@ impl FilterTable {
                 values.push(filter.eval((x as f32 + 0.5) * step, (y as f32 + 0.5) * step));
             }
         }
+        let separable = separable_factor(&values);
         Self {
             radius,
             scale: TABLE_RES as f32 / radius,
             values,
+            separable,
         }
     }
 
@@ -48,14 +57,41 @@ impl FilterTable {
     /// The filter's weight at offset (`dx`, `dy`).
     #[inline]
     pub fn weight(&self, dx: f32, dy: f32) -> f32 {
-        let ix = (dx.abs() * self.scale) as usize;
-        let iy = (dy.abs() * self.scale) as usize;
-        if ix >= TABLE_RES || iy >= TABLE_RES {
-            0.0
-        } else {
-            self.values[iy * TABLE_RES + ix]
+        match (self.index(dx), self.index(dy)) {
+            (Some(ix), Some(iy)) => self.values[iy * TABLE_RES + ix],
+            _ => 0.0,
         }
     }
+
+    /// The table cell of offset `d` along one axis, if inside the support.
+    #[inline]
+    fn index(&self, d: f32) -> Option<usize> {
+        let i = (d.abs() * self.scale) as usize;
+        (i < TABLE_RES).then_some(i)
+    }
+
+    /// The separable factor g at offset `d` (see `separable`).
+    #[inline]
+    fn factor(factor: &[f32], index: Option<usize>) -> f32 {
+        index.map_or(0.0, |i| factor[i])
+    }
+}
+
+/// If the table is the outer product g(x)·g(y) of one function with itself
+/// (box, tent, gaussian and the usual windowed filters are), returns g.
+fn separable_factor(values: &[f32]) -> Option<Vec<f32>> {
+    let centre = values[0];
+    if centre <= 0.0 {
+        return None;
+    }
+    let norm = centre.sqrt();
+    let g: Vec<f32> = values[..TABLE_RES].iter().map(|v| v / norm).collect();
+    let max = values.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+    let tolerance = 1e-5 * max;
+    let product_matches = (0..TABLE_RES).all(|iy| {
+        (0..TABLE_RES).all(|ix| (values[iy * TABLE_RES + ix] - g[ix] * g[iy]).abs() <= tolerance)
+    });
+    product_matches.then_some(g)
 }
 
 /// A linear-RGB image.
@@ -134,6 +170,24 @@ impl TileFilm {
         let py0 = ((pos.y - 0.5 - r).ceil() as i32).max(0);
         let py1 = ((pos.y - 0.5 + r).floor() as i32).min(self.image_height - 1);
         let v = value.extend(1.0);
+        let taps = (px1 - px0 + 1).max(0) as usize;
+        if let (Some(g), true) = (&table.separable, taps <= MAX_TAPS) {
+            // One column of weights, reused on every row.
+            let mut wx = [0.0f32; MAX_TAPS];
+            for (j, w) in wx[..taps].iter_mut().enumerate() {
+                let dx = (px0 + j as i32) as f32 + 0.5 - pos.x;
+                *w = FilterTable::factor(g, table.index(dx));
+            }
+            for y in py0..=py1 {
+                let wy = FilterTable::factor(g, table.index(y as f32 + 0.5 - pos.y));
+                let start = ((y - self.y0) * self.width + px0 - self.x0) as usize;
+                let vy = v * wy;
+                for (sum, &w) in self.sums[start..start + taps].iter_mut().zip(&wx[..taps]) {
+                    *sum += vy * w;
+                }
+            }
+            return;
+        }
         for y in py0..=py1 {
             let dy = y as f32 + 0.5 - pos.y;
             let row = &mut self.sums[((y - self.y0) * self.width) as usize..];
@@ -237,6 +291,46 @@ mod tests {
         let image = film.develop();
         for p in &image.pixels {
             assert!((*p - Rgb::new(0.25, 0.5, 1.0)).abs().max_element() < 1e-5);
+        }
+    }
+
+    /// A radially symmetric filter, which is not separable.
+    struct Disk;
+    impl Filter for Disk {
+        fn radius(&self) -> f32 {
+            1.5
+        }
+        fn eval(&self, x: f32, y: f32) -> f32 {
+            (1.5 - (x * x + y * y).sqrt()).max(0.0)
+        }
+    }
+
+    #[test]
+    fn separable_filters_are_detected() {
+        assert!(FilterTable::new(&Tent).separable.is_some());
+        assert!(FilterTable::new(&Disk).separable.is_none());
+    }
+
+    #[test]
+    fn separable_splats_match_the_two_dimensional_table() {
+        let table = FilterTable::new(&Tent);
+        let general = FilterTable {
+            separable: None,
+            ..table.clone()
+        };
+        let mut fast = TileFilm::new(0, 0, 8, 8, (8, 8), table.radius());
+        let mut slow = fast.clone();
+        for (i, pos) in [(0.1, 0.2), (3.5, 3.5), (7.9, 0.4), (4.25, 6.75)]
+            .into_iter()
+            .enumerate()
+        {
+            let pos = Vec2::new(pos.0, pos.1);
+            let value = Rgb::new(1.0, 2.0, 0.5) * (i + 1) as f32;
+            fast.splat(pos, value, &table);
+            slow.splat(pos, value, &general);
+        }
+        for (a, b) in fast.sums.iter().zip(&slow.sums) {
+            assert!((*a - *b).abs().max_element() <= 1e-5 * b.abs().max_element().max(1.0));
         }
     }
 

@@ -104,7 +104,14 @@ pub struct Wavefront {
     pub rays: u64,
 }
 
+/// Gives `v` length `n` for a stage that writes every element (old values
+/// stay until overwritten; only growth initialises).
 fn fit<T: Clone + Default>(v: &mut Vec<T>, n: usize) {
+    v.resize(n, T::default());
+}
+
+/// Gives `v` length `n`, every element `T::default()`.
+fn zeroed<T: Clone + Default>(v: &mut Vec<T>, n: usize) {
     v.clear();
     v.resize(n, T::default());
 }
@@ -172,7 +179,7 @@ impl Wavefront {
         for (b, w) in self.beta.iter_mut().zip(&self.u1) {
             *b = Rgb::splat(*w);
         }
-        fit(&mut self.radiance, n);
+        zeroed(&mut self.radiance, n);
         fit(&mut self.prev_pdf, n);
         fit(&mut self.hit, n);
         self.its.resize(
@@ -418,6 +425,8 @@ impl Wavefront {
                     &self.nee_wi[a..b],
                     &mut self.nee_eval[a..b],
                 );
+            } else {
+                self.nee_eval[a..b].fill(BsdfEval::default());
             }
         }
     }
