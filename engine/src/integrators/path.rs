@@ -337,17 +337,41 @@ impl Wavefront {
     /// Chooses a light per path and samples a point on it, one module call
     /// per light.
     fn sample_lights(&mut self, scene: &RenderScene, n: usize, base: u32) {
-        fit(&mut self.u1, n);
         fit(&mut self.u2, n);
-        scene.sampler.fill_1d(&self.ids_k, base, &mut self.u1);
         scene.sampler.fill_2d(&self.ids_k, base + 1, &mut self.u2);
         fit(&mut self.light, n);
         fit(&mut self.light_prob, n);
+        fit(&mut self.light_sample, n);
+        if let [light] = scene.lights.lights() {
+            // One light: no choice to make and no grouping.
+            self.light.fill(0);
+            self.light_prob.fill(1.0);
+            fit(&mut self.refs, n);
+            for (r, &slot) in self.refs.iter_mut().zip(&self.live) {
+                *r = self.its[slot as usize].p;
+            }
+            light.sample(&self.refs, &self.u2, &mut self.light_sample);
+        } else {
+            self.sample_chosen_lights(scene, n, base);
+        }
+        // Directions towards the light samples, in the local frames.
+        fit(&mut self.nee_wi, n);
         for k in 0..n {
-            let (l, p, rescaled) = scene.lights.select(self.u1[k]);
+            let it = &self.its[self.live[k] as usize];
+            let wi = (self.light_sample[k].p - it.p).normalize_or_zero();
+            self.nee_wi[k] = it.frame.to_local(wi);
+        }
+    }
+
+    /// Chooses a light per path in proportion to power and samples the
+    /// chosen lights, one module call per light.
+    fn sample_chosen_lights(&mut self, scene: &RenderScene, n: usize, base: u32) {
+        fit(&mut self.u1, n);
+        scene.sampler.fill_1d(&self.ids_k, base, &mut self.u1);
+        for k in 0..n {
+            let (l, p, _) = scene.lights.select(self.u1[k]);
             self.light[k] = l as u32;
             self.light_prob[k] = p;
-            self.u1[k] = rescaled;
         }
         self.by_light.clear();
         self.by_light.extend(0..n as u32);
@@ -379,16 +403,8 @@ impl Wavefront {
                 );
             }
         }
-        fit(&mut self.light_sample, n);
         for (j, &k) in self.by_light.iter().enumerate() {
             self.light_sample[k as usize] = self.light_out[j];
-        }
-        // Directions towards the light samples, in the local frames.
-        fit(&mut self.nee_wi, n);
-        for k in 0..n {
-            let it = &self.its[self.live[k] as usize];
-            let wi = (self.light_sample[k].p - it.p).normalize_or_zero();
-            self.nee_wi[k] = it.frame.to_local(wi);
         }
     }
 
