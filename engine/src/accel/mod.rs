@@ -1,7 +1,7 @@
 //! Acceleration: the BVH over all primitives and robust ray queries.
 //!
 //! obvhs builds a binary BVH over the primitives' boxes, which [`wide`]
-//! collapses into the 4-wide BVH that rays traverse. Primitives (triangles
+//! collapses into the 8-wide BVH that rays traverse. Primitives (triangles
 //! and analytic spheres) are numbered in its leaf order, so a leaf's
 //! primitives are contiguous and a hit's primitive index addresses the
 //! shading arrays directly. A leaf's triangles are stored as packets of
