@@ -15,7 +15,9 @@
 use crate::load::{Texels, load};
 use crate::wrap::WrapMode;
 use radiant_core::glam::Vec2;
-use radiant_core::{BuildContext, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb, Texture};
+use radiant_core::{
+    BuildContext, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb, Texture,
+};
 use serde::Deserialize;
 
 /// How lookups between texel centres are reconstructed.
@@ -41,12 +43,15 @@ pub struct ImageTexture {
 impl ImageTexture {
     /// A texture over `texels` (at least one texel).
     pub fn new(texels: Texels, filtering: Filtering, wrap: WrapMode) -> Self {
-        let sum = texels
-            .data
-            .iter()
-            .fold([0.0f64; 3], |s, t| [s[0] + t.x as f64, s[1] + t.y as f64, s[2] + t.z as f64]);
+        let sum = texels.data.iter().fold([0.0f64; 3], |s, t| {
+            [s[0] + t.x as f64, s[1] + t.y as f64, s[2] + t.z as f64]
+        });
         let n = texels.data.len().max(1) as f64;
-        let mean = Rgb::new((sum[0] / n) as f32, (sum[1] / n) as f32, (sum[2] / n) as f32);
+        let mean = Rgb::new(
+            (sum[0] / n) as f32,
+            (sum[1] / n) as f32,
+            (sum[2] / n) as f32,
+        );
         Self {
             texels,
             filtering,
@@ -97,7 +102,7 @@ impl Texture for ImageTexture {
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct ImageParams {
+pub(crate) struct ImageParams {
     filename: String,
     #[serde(default)]
     raw: bool,
@@ -107,7 +112,7 @@ struct ImageParams {
     wrap: WrapMode,
 }
 
-const DOCS: &[ParamDoc] = &[
+pub(crate) const DOCS: &[ParamDoc] = &[
     ParamDoc {
         name: "filename",
         ty: "path (PNG, JPEG, EXR, HDR)",

@@ -55,7 +55,7 @@ impl Texture for Checkerboard {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct CheckerboardParams {
+pub(crate) struct CheckerboardParams {
     #[serde(default = "default_color0")]
     color0: Spanned<TextureInput>,
     #[serde(default = "default_color1")]
@@ -70,7 +70,7 @@ fn default_color1() -> Spanned<TextureInput> {
     TextureInput::spanned_value(Rgb::splat(0.2))
 }
 
-const DOCS: &[ParamDoc] = &[
+pub(crate) const DOCS: &[ParamDoc] = &[
     ParamDoc {
         name: "color0",
         ty: "rgb | number | texture",

@@ -47,5 +47,9 @@ pub(crate) fn grid_mean(eval: impl Fn(&[Vec2], &mut [Rgb])) -> Rgb {
         }
     }
     let n = (N * N) as f64;
-    Rgb::new((sum[0] / n) as f32, (sum[1] / n) as f32, (sum[2] / n) as f32)
+    Rgb::new(
+        (sum[0] / n) as f32,
+        (sum[1] / n) as f32,
+        (sum[2] / n) as f32,
+    )
 }

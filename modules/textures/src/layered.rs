@@ -52,13 +52,13 @@ impl Texture for Layered {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct LayeredParams {
+pub(crate) struct LayeredParams {
     upper: Spanned<TextureInput>,
     lower: Spanned<TextureInput>,
     mask: Spanned<TextureInput>,
 }
 
-const DOCS: &[ParamDoc] = &[
+pub(crate) const DOCS: &[ParamDoc] = &[
     ParamDoc {
         name: "upper",
         ty: "rgb | number | texture",

@@ -91,7 +91,13 @@ fn load_image(path: &Path, raw: bool) -> Result<Texels, LoadError> {
         image::ColorType::Rgb32F | image::ColorType::Rgba32F
     );
     let rgb = decoded.to_rgb32f();
-    let decode = |c: f32| if is_float || raw { c } else { srgb_to_linear(c) };
+    let decode = |c: f32| {
+        if is_float || raw {
+            c
+        } else {
+            srgb_to_linear(c)
+        }
+    };
     Ok(Texels {
         width: rgb.width(),
         height: rgb.height(),

@@ -9,8 +9,8 @@ use radiant_core::{
     BuildContext, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb, Texture, TextureInput,
     TextureRef,
 };
-use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
+use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use std::fmt;
 
 /// A texture read through an affine map of its coordinates.
@@ -84,7 +84,9 @@ impl<'de> Deserialize<'de> for Pair {
                 v.trim()
                     .parse::<f32>()
                     .map(|x| Pair(Vec2::splat(x)))
-                    .map_err(|_| E::custom(format!("expected a number or a [u, v] list, found `{v}`")))
+                    .map_err(|_| {
+                        E::custom(format!("expected a number or a [u, v] list, found `{v}`"))
+                    })
             }
             fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Pair, A::Error> {
                 let mut c = [0.0f32; 2];
@@ -105,7 +107,7 @@ impl<'de> Deserialize<'de> for Pair {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct UvTransformParams {
+pub(crate) struct UvTransformParams {
     texture: Spanned<TextureInput>,
     #[serde(default = "one")]
     scale: Pair,
@@ -123,7 +125,7 @@ fn zero() -> Pair {
     Pair(Vec2::ZERO)
 }
 
-const DOCS: &[ParamDoc] = &[
+pub(crate) const DOCS: &[ParamDoc] = &[
     ParamDoc {
         name: "texture",
         ty: "texture name | rgb | number",
@@ -172,8 +174,10 @@ pub(crate) fn register(registry: &mut Registry) {
                 }
             }
             let texture = resolve(ctx, &p.texture)?;
-            Ok(Box::new(UvTransform::new(texture, p.scale.0, p.rotate, p.offset.0))
-                as Box<dyn Texture>)
+            Ok(
+                Box::new(UvTransform::new(texture, p.scale.0, p.rotate, p.offset.0))
+                    as Box<dyn Texture>,
+            )
         },
     );
 }

@@ -38,9 +38,18 @@ mod tests {
     fn indices_map_into_the_image() {
         let n = 4;
         let idx = |m: WrapMode| (-5..9).map(|i| m.apply(i, n)).collect::<Vec<_>>();
-        assert_eq!(idx(WrapMode::Repeat), [3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0]);
-        assert_eq!(idx(WrapMode::Clamp), [0, 0, 0, 0, 0, 0, 1, 2, 3, 3, 3, 3, 3, 3]);
-        assert_eq!(idx(WrapMode::Mirror), [3, 3, 2, 1, 0, 0, 1, 2, 3, 3, 2, 1, 0, 0]);
+        assert_eq!(
+            idx(WrapMode::Repeat),
+            [3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0]
+        );
+        assert_eq!(
+            idx(WrapMode::Clamp),
+            [0, 0, 0, 0, 0, 0, 1, 2, 3, 3, 3, 3, 3, 3]
+        );
+        assert_eq!(
+            idx(WrapMode::Mirror),
+            [3, 3, 2, 1, 0, 0, 1, 2, 3, 3, 2, 1, 0, 0]
+        );
         assert_eq!(WrapMode::Repeat.apply(i64::MIN, 3), 1);
         assert_eq!(WrapMode::Mirror.apply(i64::MAX, 3), 1);
     }
