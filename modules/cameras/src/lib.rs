@@ -28,3 +28,6 @@ pub fn register(registry: &mut Registry) {
     orthographic::register(registry);
     spherical::register(registry);
 }
+
+#[cfg(test)]
+mod tests;
