@@ -118,7 +118,11 @@ fn spherical_rays_map_back_through_longitude_and_latitude() {
         // Longitude wraps at the image's left and right edges and is
         // undefined at the poles.
         let dx = (back.x - p.x).abs();
-        let dx = if lambda.cos() > 1e-3 { dx.min(RES.x - dx) } else { 0.0 };
+        let dx = if lambda.cos() > 1e-3 {
+            dx.min(RES.x - dx)
+        } else {
+            0.0
+        };
         assert!(dx < 2e-3 && (back.y - p.y).abs() < 2e-3, "{p} → {back}");
     }
 }
