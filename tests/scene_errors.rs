@@ -54,7 +54,7 @@ fn unknown_module_type_lists_the_known_ones_and_suggests_the_closest() {
         &[
             "unknown camera type `perspectiv`",
             "did you mean `perspective`",
-            "known camera types: perspective",
+            "known camera types: orthographic, perspective, spherical, thin_lens",
         ],
     );
     assert_eq!(err.location.unwrap().column, 16);

@@ -109,6 +109,64 @@ impl Chi2 {
                 expected[c] += pdf(d) * dz * dphi * n;
             }
         }
+        self.test(&observed, &expected, succeeded, drawn)
+    }
+
+    /// Runs the test on points of the rectangle [`lo`, `hi`] (or `None` for
+    /// a failed sample) drawn by a routine whose density per unit area is
+    /// `pdf`, over `phi_cells` × `theta_cells` cells along x × y.
+    pub fn run_planar(
+        &self,
+        lo: Vec2,
+        hi: Vec2,
+        samples: impl IntoIterator<Item = Option<Vec2>>,
+        pdf: impl Fn(Vec2) -> f64,
+    ) -> Result<f64, String> {
+        let (nx, ny) = (self.phi_cells, self.theta_cells);
+        let size = hi - lo;
+        let mut observed = vec![0.0f64; nx * ny];
+        let (mut succeeded, mut drawn) = (0usize, 0usize);
+        for s in samples {
+            drawn += 1;
+            let Some(p) = s else { continue };
+            let q = (p - lo) / size;
+            if !(q.x >= 0.0 && q.y >= 0.0 && q.x < 1.0 && q.y < 1.0) {
+                return Err(format!("sample {p} lies outside [{lo}, {hi}]"));
+            }
+            if pdf(p) <= 0.0 {
+                return Err(format!("sample {p} has zero density"));
+            }
+            let (i, j) = ((q.x * nx as f32) as usize, (q.y * ny as f32) as usize);
+            observed[j.min(ny - 1) * nx + i.min(nx - 1)] += 1.0;
+            succeeded += 1;
+        }
+        let n = drawn as f64;
+        let (fx, fy) = (nx * self.refine, ny * self.refine);
+        let (dx, dy) = (size.x as f64 / fx as f64, size.y as f64 / fy as f64);
+        let mut expected = vec![0.0f64; nx * ny];
+        for j in 0..fy {
+            for i in 0..fx {
+                let p = Vec2::new(
+                    (lo.x as f64 + (i as f64 + 0.5) * dx) as f32,
+                    (lo.y as f64 + (j as f64 + 0.5) * dy) as f32,
+                );
+                expected[(j / self.refine) * nx + i / self.refine] += pdf(p) * dx * dy * n;
+            }
+        }
+        self.test(&observed, &expected, succeeded, drawn)
+    }
+
+    /// The normalisation check and the pooled chi-square test shared by
+    /// [`run`](Self::run) and [`run_planar`](Self::run_planar).
+    fn test(
+        &self,
+        observed: &[f64],
+        expected: &[f64],
+        succeeded: usize,
+        drawn: usize,
+    ) -> Result<f64, String> {
+        let n = drawn as f64;
+        let cells = observed.len();
         let integral: f64 = expected.iter().sum::<f64>() / n;
         let success = succeeded as f64 / n;
         if (integral - success).abs() > 0.01 + 3.0 / n.sqrt() {

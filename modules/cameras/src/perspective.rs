@@ -1,27 +1,9 @@
 //! The `perspective` camera: an ideal pinhole.
 
+use crate::projection::{FOV_AXIS_DOC, FOV_DOC, FovAxis, InvalidParam, Pinhole, default_fov};
 use radiant_core::glam::{Mat4, Vec2, Vec3};
-use radiant_core::{
-    BuildContext, Camera, CameraRays, ModuleInfo, ParamDoc, ParamError, Params, Registry,
-};
+use radiant_core::{BuildContext, Camera, CameraRays, ModuleInfo, ParamDoc, Params, Registry};
 use serde::Deserialize;
-
-/// Which image axis the field of view is measured along.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum FovAxis {
-    /// The horizontal axis.
-    #[default]
-    X,
-    /// The vertical axis.
-    Y,
-    /// The shorter of the two.
-    Smaller,
-    /// The longer of the two.
-    Larger,
-    /// The image diagonal.
-    Diagonal,
-}
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -32,33 +14,14 @@ struct PerspectiveParams {
     fov_axis: FovAxis,
 }
 
-fn default_fov() -> f32 {
-    45.0
-}
-
-const DOCS: &[ParamDoc] = &[
-    ParamDoc {
-        name: "fov",
-        ty: "degrees, (0, 180)",
-        default: "45",
-        doc: "Full field of view along `fov_axis`.",
-    },
-    ParamDoc {
-        name: "fov_axis",
-        ty: "x | y | smaller | larger | diagonal",
-        default: "x",
-        doc: "Image axis the field of view is measured along.",
-    },
-];
+const DOCS: &[ParamDoc] = &[FOV_DOC, FOV_AXIS_DOC];
 
 /// An ideal pinhole camera (Mitsuba 3's `perspective` without clipping
 /// planes): rays start at the pose origin and go through the film.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Perspective {
     to_render: Mat4,
-    /// tan(half field of view) along x and y.
-    tan_half: Vec2,
-    resolution: Vec2,
+    pinhole: Pinhole,
 }
 
 impl Perspective {
@@ -68,37 +31,10 @@ impl Perspective {
         resolution: Vec2,
         fov_degrees: f32,
         axis: FovAxis,
-    ) -> Result<Self, String> {
-        if !(fov_degrees > 0.0 && fov_degrees < 180.0) {
-            return Err(format!(
-                "fov must be between 0 and 180 degrees (exclusive), found {fov_degrees}"
-            ));
-        }
-        let aspect = resolution.x / resolution.y;
-        let t = (fov_degrees.to_radians() * 0.5).tan();
-        let along_x = match axis {
-            FovAxis::X => true,
-            FovAxis::Y => false,
-            FovAxis::Smaller => aspect <= 1.0,
-            FovAxis::Larger => aspect > 1.0,
-            FovAxis::Diagonal => {
-                let diag = (1.0 + 1.0 / (aspect * aspect)).sqrt();
-                return Ok(Self {
-                    to_render,
-                    tan_half: Vec2::new(t / diag, t / diag / aspect),
-                    resolution,
-                });
-            }
-        };
-        let tan_half = if along_x {
-            Vec2::new(t, t / aspect)
-        } else {
-            Vec2::new(t * aspect, t)
-        };
+    ) -> Result<Self, InvalidParam> {
         Ok(Self {
             to_render,
-            tan_half,
-            resolution,
+            pinhole: Pinhole::new(resolution, fov_degrees, axis)?,
         })
     }
 }
@@ -106,11 +42,8 @@ impl Perspective {
 impl Camera for Perspective {
     fn generate(&self, film: &[Vec2], _lens: &[Vec2], out: CameraRays<'_>) {
         let origin = self.to_render.transform_point3(Vec3::ZERO);
-        let scale = 2.0 / self.resolution;
         for (i, p) in film.iter().enumerate() {
-            let ndc = Vec2::new(p.x * scale.x - 1.0, 1.0 - p.y * scale.y);
-            // Camera space: +x left, +y up, +z forward.
-            let local = Vec3::new(-ndc.x * self.tan_half.x, ndc.y * self.tan_half.y, 1.0);
+            let local = self.pinhole.plane_point(*p).extend(1.0);
             out.origins[i] = origin;
             out.directions[i] = self.to_render.transform_vector3(local).normalize();
             out.weights[i] = 1.0;
@@ -133,10 +66,7 @@ pub(crate) fn register(registry: &mut Registry) {
                 p.fov,
                 p.fov_axis,
             )
-            .map_err(|msg| ParamError {
-                message: msg,
-                location: params.location_of("fov"),
-            })?;
+            .map_err(|e| e.at(params))?;
             Ok(Box::new(camera) as Box<dyn Camera>)
         },
     );

@@ -6,6 +6,7 @@
 
 use crate::{Effects, Rgb};
 use glam::Vec2;
+use std::sync::Arc;
 
 /// A texture module: evaluates colours for a batch of (u, v) coordinates.
 pub trait Texture: Send + Sync {
@@ -30,29 +31,61 @@ pub trait Texture: Send + Sync {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct TextureId(pub u32);
 
-enum Entry {
+/// A texture as another module holds it (e.g. the layers of a `layered`
+/// texture): a constant, or a shared module instance.
+#[derive(Clone)]
+pub enum TextureRef {
+    /// A value that does not vary.
     Constant(Rgb),
-    Module(Box<dyn Texture>),
+    /// A texture module, shared with the scene's [`TextureTable`].
+    Module(Arc<dyn Texture>),
+}
+
+impl TextureRef {
+    /// Writes the texture's value at `uv[i]` into `out[i]`.
+    #[inline]
+    pub fn eval(&self, uv: &[Vec2], out: &mut [Rgb]) {
+        match self {
+            TextureRef::Constant(c) => out[..uv.len()].fill(*c),
+            TextureRef::Module(t) => t.eval(uv, &mut out[..uv.len()]),
+        }
+    }
+
+    /// The mean value over the unit square.
+    pub fn mean(&self) -> Rgb {
+        match self {
+            TextureRef::Constant(c) => *c,
+            TextureRef::Module(t) => t.mean(),
+        }
+    }
+
+    /// Effects the texture needs.
+    pub fn effects(&self) -> Effects {
+        match self {
+            TextureRef::Constant(_) => Effects::empty(),
+            TextureRef::Module(t) => t.effects(),
+        }
+    }
 }
 
 /// All textures of a scene.
 #[derive(Default)]
 pub struct TextureTable {
-    entries: Vec<Entry>,
+    entries: Vec<TextureRef>,
 }
 
 impl TextureTable {
     /// Adds an inline constant value and returns its id.
     pub fn add_constant(&mut self, value: Rgb) -> TextureId {
-        self.entries.push(Entry::Constant(value));
+        self.entries.push(TextureRef::Constant(value));
         TextureId(self.entries.len() as u32 - 1)
     }
 
     /// Adds a texture module instance and returns its id.
     pub fn add(&mut self, texture: Box<dyn Texture>) -> TextureId {
         let entry = match texture.constant() {
-            Some(c) => Entry::Constant(c),
-            None => Entry::Module(texture),
+            Some(c) => TextureRef::Constant(c),
+            None => TextureRef::Module(Arc::from(texture)),
         };
         self.entries.push(entry);
         TextureId(self.entries.len() as u32 - 1)
@@ -61,34 +94,31 @@ impl TextureTable {
     /// Evaluates texture `id` at every `uv[i]` into `out[i]`.
     #[inline]
     pub fn eval(&self, id: TextureId, uv: &[Vec2], out: &mut [Rgb]) {
-        match &self.entries[id.0 as usize] {
-            Entry::Constant(c) => out[..uv.len()].fill(*c),
-            Entry::Module(t) => t.eval(uv, &mut out[..uv.len()]),
-        }
+        self.entries[id.0 as usize].eval(uv, out);
+    }
+
+    /// A handle on texture `id` that another module can keep (textures
+    /// built from other textures hold their inputs this way).
+    pub fn get(&self, id: TextureId) -> TextureRef {
+        self.entries[id.0 as usize].clone()
     }
 
     /// The constant value of texture `id`, if it does not vary.
     pub fn constant(&self, id: TextureId) -> Option<Rgb> {
         match &self.entries[id.0 as usize] {
-            Entry::Constant(c) => Some(*c),
-            Entry::Module(_) => None,
+            TextureRef::Constant(c) => Some(*c),
+            TextureRef::Module(_) => None,
         }
     }
 
     /// The mean value of texture `id` over the unit square.
     pub fn mean(&self, id: TextureId) -> Rgb {
-        match &self.entries[id.0 as usize] {
-            Entry::Constant(c) => *c,
-            Entry::Module(t) => t.mean(),
-        }
+        self.entries[id.0 as usize].mean()
     }
 
     /// Effects needed by texture `id`.
     pub fn effects(&self, id: TextureId) -> Effects {
-        match &self.entries[id.0 as usize] {
-            Entry::Constant(_) => Effects::empty(),
-            Entry::Module(t) => t.effects(),
-        }
+        self.entries[id.0 as usize].effects()
     }
 
     /// Number of textures, constants included.

@@ -1,82 +1,43 @@
 //! # radiant-textures: built-in texture modules
 //!
 //! Textures are read by shaders in batches through the scene's
-//! [`TextureTable`](radiant_core::TextureTable).
+//! [`TextureTable`](radiant_core::TextureTable). `constant` and `image`
+//! are leaves; `checkerboard`, `layered` and `uv_transform` are built from
+//! other textures (inline values or names defined earlier under
+//! `textures:`), which they hold as [`TextureRef`](radiant_core::TextureRef)s
+//! and evaluate chunk by chunk on the stack (`compose`). Image files are
+//! decoded once at build time (`load`, `srgb`) and looked up with a wrap
+//! mode (`wrap`).
 
-use radiant_core::glam::Vec2;
-use radiant_core::{Color, Effects, ModuleInfo, ParamDoc, Params, Registry, Rgb, Texture};
-use serde::Deserialize;
+mod bitmap;
+mod checkerboard;
+mod compose;
+mod constant;
+mod layered;
+mod load;
+mod srgb;
+mod uv_transform;
+mod wrap;
 
-/// A texture with the same value everywhere.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Constant {
-    value: Rgb,
-}
+pub use bitmap::{Filtering, ImageTexture};
+pub use checkerboard::Checkerboard;
+pub use constant::Constant;
+pub use layered::Layered;
+pub use load::{LoadError, Texels, load};
+pub use srgb::{linear_to_srgb, srgb_to_linear};
+pub use uv_transform::UvTransform;
+pub use wrap::WrapMode;
 
-impl Texture for Constant {
-    fn eval(&self, uv: &[Vec2], out: &mut [Rgb]) {
-        out[..uv.len()].fill(self.value);
-    }
-
-    fn constant(&self) -> Option<Rgb> {
-        Some(self.value)
-    }
-
-    fn mean(&self) -> Rgb {
-        self.value
-    }
-
-    fn effects(&self) -> Effects {
-        Effects::empty()
-    }
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ConstantParams {
-    value: Color,
-}
-
-const CONSTANT_DOCS: &[ParamDoc] = &[ParamDoc {
-    name: "value",
-    ty: "rgb | number",
-    default: "required",
-    doc: "The value everywhere.",
-}];
+use radiant_core::Registry;
 
 /// Registers every built-in texture type.
 pub fn register(registry: &mut Registry) {
-    registry.register::<dyn Texture>(
-        ModuleInfo {
-            type_name: "constant",
-            summary: "The same value everywhere.",
-            params: CONSTANT_DOCS,
-        },
-        |params: &Params, _| {
-            let p: ConstantParams = params.parse()?;
-            Ok(Box::new(Constant { value: p.value.0 }) as Box<dyn Texture>)
-        },
-    );
+    constant::register(registry);
+    bitmap::register(registry);
+    checkerboard::register(registry);
+    layered::register(registry);
+    uv_transform::register(registry);
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use radiant_core::params::check_param_docs;
-
-    #[test]
-    fn documented_parameters_match() {
-        check_param_docs::<ConstantParams>(CONSTANT_DOCS).unwrap();
-    }
-
-    #[test]
-    fn constant_is_constant() {
-        let t = Constant {
-            value: Rgb::new(0.1, 0.2, 0.3),
-        };
-        let mut out = [Rgb::ZERO; 3];
-        t.eval(&[Vec2::ZERO, Vec2::ONE, Vec2::splat(0.5)], &mut out);
-        assert!(out.iter().all(|&c| c == Rgb::new(0.1, 0.2, 0.3)));
-        assert_eq!(t.constant(), Some(t.value));
-    }
-}
+mod tests;

@@ -1,0 +1,101 @@
+//! The `orthographic` camera: parallel rays through a rectangular window.
+//!
+//! Rays start on the camera-space plane z = 0 and all point along +z. The
+//! window is `width` scene units wide (x ∈ [−w/2, w/2]) with the film's
+//! aspect ratio; the default 2 is Mitsuba 3's [−1, 1] window, which a scale
+//! in the camera's `transform` resizes in both renderers.
+
+use crate::projection::{InvalidParam, Raster, check_min};
+use radiant_core::glam::{Mat4, Vec2, Vec3};
+use radiant_core::{BuildContext, Camera, CameraRays, ModuleInfo, ParamDoc, Params, Registry};
+use serde::Deserialize;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OrthographicParams {
+    #[serde(default = "default_width")]
+    width: f32,
+}
+
+fn default_width() -> f32 {
+    2.0
+}
+
+const DOCS: &[ParamDoc] = &[ParamDoc {
+    name: "width",
+    ty: "scene units, > 0",
+    default: "2",
+    doc: "Width of the viewed window; its height follows the film's aspect ratio.",
+}];
+
+/// An orthographic camera.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Orthographic {
+    to_render: Mat4,
+    raster: Raster,
+    /// Half the window's extent along x and y.
+    half: Vec2,
+}
+
+impl Orthographic {
+    /// An orthographic camera viewing a window `width` units wide.
+    pub fn new(to_render: Mat4, resolution: Vec2, width: f32) -> Result<Self, InvalidParam> {
+        let width = check_min("width", width, 0.0, false, "scene units")?;
+        let half = Vec2::new(width, width * resolution.y / resolution.x) * 0.5;
+        Ok(Self {
+            to_render,
+            raster: Raster::new(resolution),
+            half,
+        })
+    }
+}
+
+impl Camera for Orthographic {
+    fn generate(&self, film: &[Vec2], _lens: &[Vec2], out: CameraRays<'_>) {
+        let dir = self.to_render.transform_vector3(Vec3::Z).normalize();
+        for (i, p) in film.iter().enumerate() {
+            let ndc = self.raster.ndc(*p);
+            // Camera space +x is left, NDC +x is right.
+            let local = Vec3::new(-ndc.x * self.half.x, ndc.y * self.half.y, 0.0);
+            out.origins[i] = self.to_render.transform_point3(local);
+            out.directions[i] = dir;
+            out.weights[i] = 1.0;
+        }
+    }
+}
+
+pub(crate) fn register(registry: &mut Registry) {
+    registry.register::<dyn Camera>(
+        ModuleInfo {
+            type_name: "orthographic",
+            summary: "Parallel projection along the view direction. Pose from `look_at` or `transform`.",
+            params: DOCS,
+        },
+        |params: &Params, ctx: &mut BuildContext<'_>| {
+            let p: OrthographicParams = params.parse()?;
+            let camera = Orthographic::new(ctx.camera_to_render, ctx.resolution.as_vec2(), p.width)
+                .map_err(|e| e.at(params))?;
+            Ok(Box::new(camera) as Box<dyn Camera>)
+        },
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use radiant_core::params::check_param_docs;
+
+    #[test]
+    fn documented_parameters_match() {
+        check_param_docs::<OrthographicParams>(DOCS).unwrap();
+    }
+
+    #[test]
+    fn rejects_empty_windows() {
+        let res = Vec2::new(4.0, 2.0);
+        assert!(Orthographic::new(Mat4::IDENTITY, res, 0.0).is_err());
+        assert!(Orthographic::new(Mat4::IDENTITY, res, f32::INFINITY).is_err());
+        let cam = Orthographic::new(Mat4::IDENTITY, res, 4.0).unwrap();
+        assert_eq!(cam.half, Vec2::new(2.0, 1.0));
+    }
+}

@@ -1,0 +1,159 @@
+//! The `image` texture: an image file looked up with bilinear (or nearest)
+//! filtering and a wrap mode.
+//!
+//! Texture space: (u, v) = (0, 0) is the image's bottom-left corner and
+//! (1, 1) its top-right (the OBJ convention, so images appear upright on
+//! meshes and on the `rectangle` shape); texel (i, j) of a w × h image,
+//! row j counted from the top, has its centre at ((i + ½)/w, 1 − (j + ½)/h).
+//!
+//! No mipmaps: the integrator does not track ray footprints, so lookups
+//! are point samples of the bilinear reconstruction. A minified texture is
+//! therefore noisy at low sample counts, but the pixel filter integrates
+//! it, and the render converges to the correctly filtered image (mipmaps
+//! would lower that noise at the price of a blur bias).
+
+use crate::load::{Texels, load};
+use crate::wrap::WrapMode;
+use radiant_core::glam::Vec2;
+use radiant_core::{
+    BuildContext, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb, Texture,
+};
+use serde::Deserialize;
+
+/// How lookups between texel centres are reconstructed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Filtering {
+    /// Bilinear interpolation of the four nearest texels.
+    #[default]
+    Bilinear,
+    /// The texel the point falls in.
+    Nearest,
+}
+
+/// An image texture.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImageTexture {
+    texels: Texels,
+    filtering: Filtering,
+    wrap: WrapMode,
+    mean: Rgb,
+}
+
+impl ImageTexture {
+    /// A texture over `texels` (at least one texel).
+    pub fn new(texels: Texels, filtering: Filtering, wrap: WrapMode) -> Self {
+        let sum = texels.data.iter().fold([0.0f64; 3], |s, t| {
+            [s[0] + t.x as f64, s[1] + t.y as f64, s[2] + t.z as f64]
+        });
+        let n = texels.data.len().max(1) as f64;
+        let mean = Rgb::new(
+            (sum[0] / n) as f32,
+            (sum[1] / n) as f32,
+            (sum[2] / n) as f32,
+        );
+        Self {
+            texels,
+            filtering,
+            wrap,
+            mean,
+        }
+    }
+
+    #[inline]
+    fn texel(&self, x: i64, y: i64) -> Rgb {
+        let (w, h) = (self.texels.width as i64, self.texels.height as i64);
+        let i = self.wrap.apply(x, w);
+        let j = self.wrap.apply(y, h);
+        self.texels.data[j * w as usize + i]
+    }
+
+    #[inline]
+    fn lookup(&self, uv: Vec2) -> Rgb {
+        // Continuous texel coordinates, rows from the top.
+        let x = uv.x * self.texels.width as f32;
+        let y = (1.0 - uv.y) * self.texels.height as f32;
+        match self.filtering {
+            Filtering::Nearest => self.texel(x.floor() as i64, y.floor() as i64),
+            Filtering::Bilinear => {
+                let (x, y) = (x - 0.5, y - 0.5);
+                let (x0, y0) = (x.floor(), y.floor());
+                let (fx, fy) = (x - x0, y - y0);
+                let (i, j) = (x0 as i64, y0 as i64);
+                let top = self.texel(i, j).lerp(self.texel(i + 1, j), fx);
+                let bottom = self.texel(i, j + 1).lerp(self.texel(i + 1, j + 1), fx);
+                top.lerp(bottom, fy)
+            }
+        }
+    }
+}
+
+impl Texture for ImageTexture {
+    fn eval(&self, uv: &[Vec2], out: &mut [Rgb]) {
+        for (o, p) in out.iter_mut().zip(uv) {
+            *o = self.lookup(*p);
+        }
+    }
+
+    fn mean(&self) -> Rgb {
+        self.mean
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ImageParams {
+    filename: String,
+    #[serde(default)]
+    raw: bool,
+    #[serde(default)]
+    filter: Filtering,
+    #[serde(default)]
+    wrap: WrapMode,
+}
+
+pub(crate) const DOCS: &[ParamDoc] = &[
+    ParamDoc {
+        name: "filename",
+        ty: "path (PNG, JPEG, EXR, HDR)",
+        default: "required",
+        doc: "The image, relative to the scene file.",
+    },
+    ParamDoc {
+        name: "raw",
+        ty: "bool",
+        default: "false",
+        doc: "Data, not colour: skip the sRGB decoding of 8/16-bit images (EXR and HDR are always linear).",
+    },
+    ParamDoc {
+        name: "filter",
+        ty: "bilinear | nearest",
+        default: "bilinear",
+        doc: "Reconstruction between texel centres (no mipmaps: the pixel filter integrates minification).",
+    },
+    ParamDoc {
+        name: "wrap",
+        ty: "repeat | clamp | mirror",
+        default: "repeat",
+        doc: "Lookups outside [0, 1]²: tile, extend the border, or tile mirrored.",
+    },
+];
+
+pub(crate) fn register(registry: &mut Registry) {
+    registry.register::<dyn Texture>(
+        ModuleInfo {
+            type_name: "image",
+            summary: "Image file with bilinear filtering; (0, 0) is the bottom-left corner.",
+            params: DOCS,
+        },
+        |params: &Params, ctx: &mut BuildContext<'_>| {
+            let p: ImageParams = params.parse()?;
+            let path = ctx.scene_dir.join(&p.filename);
+            let texels = load(&path, p.raw).map_err(|e| ParamError {
+                message: format!("{e}; expected a readable PNG, JPEG, EXR or HDR file"),
+                location: params.location_of("filename"),
+            })?;
+            Ok(Box::new(ImageTexture::new(texels, p.filter, p.wrap)) as Box<dyn Texture>)
+        },
+    );
+}

@@ -1,0 +1,109 @@
+//! Reading image files into linear RGB texels.
+//!
+//! EXR files are read with the `exr` crate, PNG, JPEG and Radiance HDR with
+//! `image`. Float formats (EXR, HDR) hold linear values and are used as
+//! they are; integer formats (8- and 16-bit PNG, JPEG) are normalised to
+//! [0, 1] and, unless the texture is `raw` data (normal, roughness or mask
+//! maps), decoded from sRGB. Alpha is ignored; grey images fill all three
+//! channels.
+
+use crate::srgb::srgb_to_linear;
+use radiant_core::Rgb;
+use std::path::{Path, PathBuf};
+
+/// Why an image could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum LoadError {
+    /// The file could not be opened or decoded.
+    #[error("cannot read image `{path}`: {message}")]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// The file holds no pixels.
+    #[error("image `{0}` has no pixels")]
+    Empty(PathBuf),
+}
+
+/// Linear RGB texels, row-major, top row first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Texels {
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// The texels.
+    pub data: Vec<Rgb>,
+}
+
+/// Reads `path` into linear texels; `raw` skips the sRGB decoding of
+/// integer formats.
+pub fn load(path: &Path, raw: bool) -> Result<Texels, LoadError> {
+    let is_exr = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    let texels = if is_exr {
+        load_exr(path)?
+    } else {
+        load_image(path, raw)?
+    };
+    if texels.width == 0 || texels.height == 0 {
+        return Err(LoadError::Empty(path.to_path_buf()));
+    }
+    Ok(texels)
+}
+
+fn read_error(path: &Path, e: impl std::fmt::Display) -> LoadError {
+    LoadError::Read {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
+}
+
+fn load_exr(path: &Path) -> Result<Texels, LoadError> {
+    use exr::prelude::read_first_rgba_layer_from_file;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |resolution, _| Texels {
+            width: resolution.width() as u32,
+            height: resolution.height() as u32,
+            data: vec![Rgb::ZERO; resolution.width() * resolution.height()],
+        },
+        |t: &mut Texels, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            t.data[pos.y() * t.width as usize + pos.x()] = Rgb::new(r, g, b);
+        },
+    )
+    .map_err(|e| read_error(path, e))?;
+    Ok(image.layer_data.channel_data.pixels)
+}
+
+fn load_image(path: &Path, raw: bool) -> Result<Texels, LoadError> {
+    let decoded = image::ImageReader::open(path)
+        .map_err(|e| read_error(path, e))?
+        .with_guessed_format()
+        .map_err(|e| read_error(path, e))?
+        .decode()
+        .map_err(|e| read_error(path, e))?;
+    let is_float = matches!(
+        decoded.color(),
+        image::ColorType::Rgb32F | image::ColorType::Rgba32F
+    );
+    let rgb = decoded.to_rgb32f();
+    let decode = |c: f32| {
+        if is_float || raw {
+            c
+        } else {
+            srgb_to_linear(c)
+        }
+    };
+    Ok(Texels {
+        width: rgb.width(),
+        height: rgb.height(),
+        data: rgb
+            .pixels()
+            .map(|p| Rgb::new(decode(p[0]), decode(p[1]), decode(p[2])))
+            .collect(),
+    })
+}
