@@ -153,10 +153,8 @@ mod tests {
 
     #[test]
     fn visible_normals_are_normalised() {
-        // E over the VNDF of 1/pdf·pdf... check ∫ pdf_visible dω = 1 by
-        // importance sampling with the VNDF itself: the mean of
-        // (wo·m)·G1/ (wo.z · pdf) · D = 1 trivially, so instead compare
-        // the sampled mean of m.z with its quadrature value.
+        // The density integrates to 1 (quadrature), and the mean of m.z
+        // over sampled normals matches its quadrature under the density.
         let ggx = Ggx::new(0.4, 0.15);
         let wo = Vec3::new(0.5, 0.3, 0.2).normalize();
         let n = 256;
