@@ -2,14 +2,14 @@
 """Render the material reference scenes with Mitsuba 3 for Radiant's tests.
 
 Each scene is Mitsuba's ``mi.cornell_box()`` with the two boxes replaced by
-two spheres of the material under test, at 128x128, max_depth 16; the
+two spheres of the material under test, at 64x64, max_depth 16; the
 Radiant scenes ``scenes/glass.yaml``, ``scenes/rough-metal.yaml`` and
 ``scenes/plastic.yaml`` describe exactly the same. Output is half-float RGB
 OpenEXR in ``tests/data/<name>-mitsuba.exr``.
 
     pip install mitsuba numpy
     apt-get install -y libllvm19
-    nice -n 10 python3 tests/reference/render_materials.py --spp 16384
+    nice -n 10 python3 tests/reference/render_materials.py --spp 8192
 
 ``--variant scalar_rgb`` avoids the LLVM dependency (much slower).
 """
@@ -21,7 +21,7 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from render_mitsuba import setup_variant  # noqa: E402
 
-SIZE = 128
+SIZE = 64
 MAX_DEPTH = 16
 LEFT = [-0.45, -0.6, -0.2]
 RIGHT = [0.45, -0.6, 0.25]
@@ -66,7 +66,7 @@ def scene_dict(mi, left, right):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--variant", default="llvm_ad_rgb")
-    ap.add_argument("--spp", type=int, default=16384)
+    ap.add_argument("--spp", type=int, default=8192)
     ap.add_argument("--pass-spp", type=int, default=1024)
     ap.add_argument("--only", help="render only this scene")
     ap.add_argument("--out-dir", default=os.path.join(

@@ -39,14 +39,18 @@ pub fn dielectric(cos_i: f32, eta: f32) -> DielectricFresnel {
         };
     }
     let cos_t_abs = cos_t2.sqrt();
+    // In double precision: near-matched indices (η = 1.0001) cancel in
+    // single precision and would give an exact zero for a tiny reflectance.
     let r = if eta == 1.0 {
         0.0
     } else if cos_i_abs == 0.0 {
         1.0
     } else {
-        let a_s = (cos_i_abs - eta_it * cos_t_abs) / (cos_i_abs + eta_it * cos_t_abs);
-        let a_p = (cos_t_abs - eta_it * cos_i_abs) / (cos_t_abs + eta_it * cos_i_abs);
-        (0.5 * (a_s * a_s + a_p * a_p)).min(1.0)
+        let (ci, et) = (cos_i_abs as f64, eta_it as f64);
+        let ct = (1.0 - (1.0 - ci * ci) / (et * et)).max(0.0).sqrt();
+        let a_s = (ci - et * ct) / (ci + et * ct);
+        let a_p = (ct - et * ci) / (ct + et * ci);
+        (0.5 * (a_s * a_s + a_p * a_p)).min(1.0) as f32
     };
     DielectricFresnel {
         r,
