@@ -33,7 +33,11 @@ fn furnace(s: &TestShader, wo: Vec3, refraction_gain: f32, seed: u64) -> (Rgb, R
         if b.pdf <= 0.0 {
             continue;
         }
-        let gain = if b.wi.z * wo.z < 0.0 { refraction_gain } else { 1.0 };
+        let gain = if b.wi.z * wo.z < 0.0 {
+            refraction_gain
+        } else {
+            1.0
+        };
         let w = (b.weight * gain).as_dvec3();
         sum += w;
         sq += w * w;
@@ -138,7 +142,11 @@ fn lossy_shaders_never_exceed_one() {
                 } else {
                     1.5 / 1.000277
                 };
-                let gain = if side > 0.0 { eta * eta } else { 1.0 / (eta * eta) };
+                let gain = if side > 0.0 {
+                    eta * eta
+                } else {
+                    1.0 / (eta * eta)
+                };
                 let (mean, err) = furnace(&s, wo, gain, 100 + k as u64);
                 if yaml.contains("rough_diffuse") {
                     worst_oren_nayar = worst_oren_nayar.max(mean.max_element());
@@ -172,10 +180,21 @@ fn sample_weights_and_densities_agree_with_eval() {
                 // f32 cancellation near index-matched refraction (η =
                 // 1.0001) costs up to ~0.3 %.
                 let rel = (e.pdf - b.pdf).abs() / b.pdf;
-                assert!(rel < 1e-2, "{yaml}: pdf {} vs eval {} at wo {wo} wi {}", b.pdf, e.pdf, b.wi);
+                assert!(
+                    rel < 1e-2,
+                    "{yaml}: pdf {} vs eval {} at wo {wo} wi {}",
+                    b.pdf,
+                    e.pdf,
+                    b.wi
+                );
                 let w = e.value / e.pdf;
                 let err = (w - b.weight).abs().max_element() / b.weight.max_element().max(1e-3);
-                assert!(err < 1e-2, "{yaml}: weight {} vs eval/pdf {w} at wo {wo} wi {}", b.weight, b.wi);
+                assert!(
+                    err < 1e-2,
+                    "{yaml}: weight {} vs eval/pdf {w} at wo {wo} wi {}",
+                    b.weight,
+                    b.wi
+                );
             }
         }
     }
@@ -208,14 +227,21 @@ fn delta_lobes_follow_fresnel() {
     }
     let frac = reflected as f64 / SAMPLES as f64;
     let sigma = (f * (1.0 - f) / SAMPLES as f64).sqrt();
-    assert!((frac - f).abs() < 5.0 * sigma, "reflected {frac} vs Fresnel {f}");
+    assert!(
+        (frac - f).abs() < 5.0 * sigma,
+        "reflected {frac} vs Fresnel {f}"
+    );
     // From inside beyond the critical angle: total internal reflection.
     let inside = direction(-0.5, 0.4);
     for b in s.sample(inside, &u[..1000]) {
         assert!(b.wi.z < 0.0 && b.pdf == 1.0);
     }
     // Smooth shaders have nothing for next-event estimation to evaluate.
-    for yaml in ["{type: dielectric}", "{type: conductor}", "{type: thin_dielectric}"] {
+    for yaml in [
+        "{type: dielectric}",
+        "{type: conductor}",
+        "{type: thin_dielectric}",
+    ] {
         let e = shader(yaml).eval(direction(0.5, 0.0), direction(0.5, std::f32::consts::PI));
         assert_eq!(e.value, Rgb::ZERO, "{yaml}");
     }
@@ -255,8 +281,14 @@ fn reciprocity() {
     // Across a refracting interface, radiance transport is reciprocal up
     // to the squared indices of the two sides.
     for (yaml, eta) in [
-        ("{type: dielectric, int_ior: 1.5, ext_ior: 1, alpha: 0.3}", 1.5f32),
-        ("{type: dielectric, int_ior: 3, ext_ior: 1, alpha: 0.8}", 3.0),
+        (
+            "{type: dielectric, int_ior: 1.5, ext_ior: 1, alpha: 0.3}",
+            1.5f32,
+        ),
+        (
+            "{type: dielectric, int_ior: 3, ext_ior: 1, alpha: 0.8}",
+            3.0,
+        ),
     ] {
         let s = shader(yaml);
         let n2 = |d: Vec3| if d.z > 0.0 { 1.0 } else { eta * eta };
@@ -303,7 +335,10 @@ fn no_nan_or_infinity_for_any_input() {
                     b.wi.is_finite() && b.weight.is_finite() && b.pdf.is_finite(),
                     "{yaml}: sample at wo {wo}: {b:?}"
                 );
-                assert!(b.pdf >= 0.0 && b.weight.min_element() >= 0.0, "{yaml}: {b:?}");
+                assert!(
+                    b.pdf >= 0.0 && b.weight.min_element() >= 0.0,
+                    "{yaml}: {b:?}"
+                );
                 if b.pdf > 0.0 {
                     assert!((b.wi.length() - 1.0).abs() < 1e-3, "{yaml}: {b:?}");
                 }
@@ -314,7 +349,10 @@ fn no_nan_or_infinity_for_any_input() {
                     e.value.is_finite() && e.pdf.is_finite() && e.pdf >= 0.0,
                     "{yaml}: eval({wo}, {wi}) = {e:?}"
                 );
-                assert!(e.value.min_element() >= 0.0, "{yaml}: eval({wo}, {wi}) = {e:?}");
+                assert!(
+                    e.value.min_element() >= 0.0,
+                    "{yaml}: eval({wo}, {wi}) = {e:?}"
+                );
             }
         }
     }
@@ -324,25 +362,46 @@ fn no_nan_or_infinity_for_any_input() {
 fn bad_parameters_are_located_errors() {
     let cases = [
         ("{type: conductor, material: Unobtainium}", "unknown metal"),
-        ("{type: conductor, material: Au, eta: 1}", "either `material`"),
+        (
+            "{type: conductor, material: Au, eta: 1}",
+            "either `material`",
+        ),
         ("{type: conductor, eta: 1}", "both `eta` and `k`"),
-        ("{type: conductor, alpha: 0.1, alpha_u: 0.2, alpha_v: 0.1}", "either `alpha`"),
-        ("{type: conductor, alpha_u: 0.2}", "both `alpha_u` and `alpha_v`"),
+        (
+            "{type: conductor, alpha: 0.1, alpha_u: 0.2, alpha_v: 0.1}",
+            "either `alpha`",
+        ),
+        (
+            "{type: conductor, alpha_u: 0.2}",
+            "both `alpha_u` and `alpha_v`",
+        ),
         ("{type: conductor, alpha: 2}", "[0, 1]"),
         ("{type: dielectric, int_ior: 1, ext_ior: 1}", "invisible"),
         ("{type: dielectric, int_ior: 0.5}", "≥ 1"),
-        ("{type: dielectric, int_ior: glas}", "unknown material `glas`"),
+        (
+            "{type: dielectric, int_ior: glas}",
+            "unknown material `glas`",
+        ),
         ("{type: plastic, alpha: -1}", "[0, 1]"),
         ("{type: plastic, alpha: rough}", "number"),
         ("{type: principled, metallic: 1.5}", "[0, 1]"),
         ("{type: principled, roughnes: 0.5}", "roughnes"),
-        ("{type: ward, diffuse_reflectance: 0.8, specular_reflectance: 0.5}", "exceed 1"),
+        (
+            "{type: ward, diffuse_reflectance: 0.8, specular_reflectance: 0.5}",
+            "exceed 1",
+        ),
         ("{type: blend, materials: [{type: diffuse}]}", "exactly two"),
         ("{type: blend, weight: 0.5}", "materials"),
-        ("{type: blend, materials: [{type: diffuse}, {type: difuse}]}", "unknown shader type"),
+        (
+            "{type: blend, materials: [{type: diffuse}, {type: difuse}]}",
+            "unknown shader type",
+        ),
         ("{type: normal_map, material: {type: diffuse}}", "normals"),
         ("{type: bump, height: ramp}", "material"),
-        ("{type: bump, height: nowhere, material: {type: diffuse}}", "undefined texture"),
+        (
+            "{type: bump, height: nowhere, material: {type: diffuse}}",
+            "undefined texture",
+        ),
     ];
     for (yaml, expect) in cases {
         match build(yaml) {

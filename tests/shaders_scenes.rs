@@ -23,8 +23,8 @@ fn passes(check: &ReferenceCheck, mean_tol: f64, block_tol: f64) -> bool {
 }
 
 fn compare(name: &str, mean_tol: f64, block_tol: f64) {
-    let reference = read_exr(root().join(format!("tests/data/{name}-mitsuba.exr")))
-        .expect("reference EXR");
+    let reference =
+        read_exr(root().join(format!("tests/data/{name}-mitsuba.exr"))).expect("reference EXR");
     let image = render_scene(
         &format!("scenes/{name}.yaml"),
         Overrides {

@@ -19,12 +19,12 @@ use crate::world::{
     CameraPose, EmitterSpec, Geometry, LightSpec, MaterialRef, ModuleSpec, Transform,
 };
 use glam::{DMat4, UVec2, Vec2, Vec3};
+use materials::NestedMaterials;
 use radiant_core::registry::ModuleType;
 use radiant_core::{
     BuildContext, Camera, Effects, EmitterShape, Filter, Light, ModuleKind, Registry, Sampler,
     Shader, Texture, TextureTable,
 };
-use materials::NestedMaterials;
 use shapes::{ShapePrim, tessellate};
 use std::collections::{BTreeSet, HashMap};
 use std::time::Duration;

@@ -2,8 +2,8 @@
 
 use crate::params::{Location, ParamError, Spanned, TextureInput};
 use crate::{Params, Shader, TextureId, TextureTable};
-use marked_yaml::Node;
 use glam::{DVec3, Mat4, UVec2, Vec3};
+use marked_yaml::Node;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -89,11 +89,7 @@ impl BuildContext<'_> {
     /// material or an inline material). The module's own serde type should
     /// accept the key (e.g. as `serde::de::IgnoredAny`) so that unknown-key
     /// checking still works.
-    pub fn material(
-        &mut self,
-        params: &Params,
-        key: &str,
-    ) -> Result<Box<dyn Shader>, ParamError> {
+    pub fn material(&mut self, params: &Params, key: &str) -> Result<Box<dyn Shader>, ParamError> {
         let node = params
             .node()
             .as_mapping()

@@ -152,7 +152,8 @@ impl Lobes {
             let x = 1.0 - 0.5 * c;
             1.0 - x * x * x * x * x
         };
-        let mut value = self.rd * (Rgb::ONE - self.rs) * (28.0 / (23.0 * PI) * fade(wi.z) * fade(wo.z) * wi.z);
+        let mut value =
+            self.rd * (Rgb::ONE - self.rs) * (28.0 / (23.0 * PI) * fade(wi.z) * fade(wo.z) * wi.z);
         let mut pdf = (1.0 - ps) * cosine_hemisphere_pdf(wi);
         if let Some(h) = (wo + wi).try_normalize() {
             let kh = wi.dot(h);
@@ -179,7 +180,8 @@ impl Shader for AshikhminShirley {
         u: &[Vec3],
         out: &mut [BsdfSample],
     ) {
-        let [rd, rs, nu, nv] = ctx.lookup([self.diffuse, self.specular, self.nu, self.nv], surface.uv);
+        let [rd, rs, nu, nv] =
+            ctx.lookup([self.diffuse, self.specular, self.nu, self.nv], surface.uv);
         for (i, o) in out.iter_mut().enumerate() {
             let wo = surface.wo[i];
             *o = BsdfSample::default();
@@ -213,7 +215,8 @@ impl Shader for AshikhminShirley {
         wi: &[Vec3],
         out: &mut [BsdfEval],
     ) {
-        let [rd, rs, nu, nv] = ctx.lookup([self.diffuse, self.specular, self.nu, self.nv], surface.uv);
+        let [rd, rs, nu, nv] =
+            ctx.lookup([self.diffuse, self.specular, self.nu, self.nv], surface.uv);
         for (i, o) in out.iter_mut().enumerate() {
             let (value, pdf) = Lobes::new(rd[i], rs[i], nu[i], nv[i]).eval(surface.wo[i], wi[i]);
             *o = BsdfEval { value, pdf };
@@ -228,7 +231,13 @@ impl Shader for AshikhminShirley {
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<AshikhminShirley, ParamError> {
     let p: AsParams = params.parse()?;
     let diffuse = checked(ctx, &p.diffuse_reflectance, "diffuse_reflectance", 0.0, 1.0)?;
-    let specular = checked(ctx, &p.specular_reflectance, "specular_reflectance", 0.0, 1.0)?;
+    let specular = checked(
+        ctx,
+        &p.specular_reflectance,
+        "specular_reflectance",
+        0.0,
+        1.0,
+    )?;
     let nu = checked(ctx, &p.exponent_u, "exponent_u", 0.0, MAX_EXPONENT)?;
     let nv = checked(ctx, &p.exponent_v, "exponent_v", 0.0, MAX_EXPONENT)?;
     Ok(AshikhminShirley {

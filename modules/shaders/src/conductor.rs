@@ -153,7 +153,8 @@ impl Shader for Conductor {
             };
             let ggx = Ggx::new(scalar(au[i]), scalar(av[i]));
             let d = ggx.d(m);
-            let value = self.fresnel.at(wo.dot(m)) * spec[i] * (d * ggx.g(wo, wi, m) / (4.0 * wo.z));
+            let value =
+                self.fresnel.at(wo.dot(m)) * spec[i] * (d * ggx.g(wo, wi, m) / (4.0 * wo.z));
             let pdf = ggx.g1(wo, m) * d / (4.0 * wo.z);
             if value.is_finite() && pdf.is_finite() {
                 *o = BsdfEval { value, pdf };
@@ -166,7 +167,10 @@ impl Shader for Conductor {
     }
 }
 
-fn build(params: &Params, ctx: &mut radiant_core::BuildContext<'_>) -> Result<Conductor, ParamError> {
+fn build(
+    params: &Params,
+    ctx: &mut radiant_core::BuildContext<'_>,
+) -> Result<Conductor, ParamError> {
     let p: ConductorParams = params.parse()?;
     let fresnel = match (&p.material, &p.eta, &p.k) {
         (Some(m), None, None) if m.eq_ignore_ascii_case("none") => Reflectance::Mirror,
@@ -185,10 +189,16 @@ fn build(params: &Params, ctx: &mut radiant_core::BuildContext<'_>) -> Result<Co
         }
         (None, Some(eta), Some(k)) => {
             if !(eta.0.is_finite() && eta.0.min_element() > 0.0) {
-                return Err(ParamError::at(eta.span(), "`eta` must be positive and finite"));
+                return Err(ParamError::at(
+                    eta.span(),
+                    "`eta` must be positive and finite",
+                ));
             }
             if !(k.0.is_finite() && k.0.min_element() >= 0.0) {
-                return Err(ParamError::at(k.span(), "`k` must be non-negative and finite"));
+                return Err(ParamError::at(
+                    k.span(),
+                    "`k` must be non-negative and finite",
+                ));
             }
             Reflectance::Complex { eta: eta.0, k: k.0 }
         }
@@ -206,7 +216,13 @@ fn build(params: &Params, ctx: &mut radiant_core::BuildContext<'_>) -> Result<Co
             ));
         }
     };
-    let specular = checked(ctx, &p.specular_reflectance, "specular_reflectance", 0.0, 1.0)?;
+    let specular = checked(
+        ctx,
+        &p.specular_reflectance,
+        "specular_reflectance",
+        0.0,
+        1.0,
+    )?;
     let rough = roughness(&p.alpha, &p.alpha_u, &p.alpha_v, ctx)?;
     let lobes = if rough.smooth {
         Effects::DELTA_LOBES

@@ -6,8 +6,8 @@
 //! radiance is scaled by (η_i/η_t)².
 
 use crate::fresnel;
-use crate::inputs::{BK7, 
-    Ior, ROUGHNESS_DOCS, Roughness, checked, relative_ior, roughness, scalar, texture_effects,
+use crate::inputs::{
+    BK7, Ior, ROUGHNESS_DOCS, Roughness, checked, relative_ior, roughness, scalar, texture_effects,
 };
 use crate::lobes::{interface_eval, interface_sample};
 use crate::microfacet::Ggx;
@@ -89,7 +89,12 @@ impl Shader for Dielectric {
         out: &mut [BsdfSample],
     ) {
         let [kr, kt, au, av] = ctx.lookup(
-            [self.reflectance, self.transmittance, self.rough.u, self.rough.v],
+            [
+                self.reflectance,
+                self.transmittance,
+                self.rough.u,
+                self.rough.v,
+            ],
             surface.uv,
         );
         for (i, o) in out.iter_mut().enumerate() {
@@ -142,7 +147,12 @@ impl Shader for Dielectric {
             return;
         }
         let [kr, kt, au, av] = ctx.lookup(
-            [self.reflectance, self.transmittance, self.rough.u, self.rough.v],
+            [
+                self.reflectance,
+                self.transmittance,
+                self.rough.u,
+                self.rough.v,
+            ],
             surface.uv,
         );
         for (i, o) in out.iter_mut().enumerate() {
@@ -164,7 +174,13 @@ impl Shader for Dielectric {
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Dielectric, ParamError> {
     let p: DielectricParams = params.parse()?;
     let eta = relative_ior(&p.int_ior, &p.ext_ior, BK7)?;
-    let reflectance = checked(ctx, &p.specular_reflectance, "specular_reflectance", 0.0, 1.0)?;
+    let reflectance = checked(
+        ctx,
+        &p.specular_reflectance,
+        "specular_reflectance",
+        0.0,
+        1.0,
+    )?;
     let transmittance = checked(
         ctx,
         &p.specular_transmittance,

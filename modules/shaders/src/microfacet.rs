@@ -85,12 +85,7 @@ impl Ggx {
         let p2 = (1.0 - h) * (1.0 - p1 * p1).max(0.0).sqrt() + h * r * s;
         let nh = t1 * p1 + t2 * p2 + vh * (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
         // Unstretch.
-        Vec3::new(
-            self.alpha_u * nh.x,
-            self.alpha_v * nh.y,
-            nh.z.max(1e-7),
-        )
-        .normalize()
+        Vec3::new(self.alpha_u * nh.x, self.alpha_v * nh.y, nh.z.max(1e-7)).normalize()
     }
 
     /// Density of [`sample_visible`](Self::sample_visible) producing `m`,

@@ -22,7 +22,11 @@ pub(crate) fn perturbed_frame(n: Vec3) -> Frame {
     let s = (Vec3::X - n * n.x)
         .try_normalize()
         .unwrap_or_else(|| Frame::from_normal(n).s);
-    Frame { s, t: n.cross(s), n }
+    Frame {
+        s,
+        t: n.cross(s),
+        n,
+    }
 }
 
 /// Samples `nested` at every point in the frame of the perturbed normal
@@ -39,7 +43,15 @@ pub(crate) fn sample(
     for i in 0..surface.len() {
         wo[i] = perturbed_frame(normals[i]).to_local(surface.wo[i]);
     }
-    nested.sample(ctx, SurfaceBatch { wo: &wo, uv: surface.uv }, u, out);
+    nested.sample(
+        ctx,
+        SurfaceBatch {
+            wo: &wo,
+            uv: surface.uv,
+        },
+        u,
+        out,
+    );
     for (i, s) in out.iter_mut().enumerate() {
         let wi = perturbed_frame(normals[i]).to_world(s.wi);
         if wi.z * s.wi.z <= 0.0 || s.pdf <= 0.0 {
@@ -68,7 +80,15 @@ pub(crate) fn eval(
         wo[i] = f.to_local(surface.wo[i]);
         wi_p[i] = f.to_local(wi[i]);
     }
-    nested.eval(ctx, SurfaceBatch { wo: &wo, uv: surface.uv }, &wi_p, out);
+    nested.eval(
+        ctx,
+        SurfaceBatch {
+            wo: &wo,
+            uv: surface.uv,
+        },
+        &wi_p,
+        out,
+    );
     for i in 0..n {
         if wi[i].z * wi_p[i].z <= 0.0 {
             out[i] = BsdfEval::default();

@@ -131,10 +131,7 @@ impl Plastic {
             Rgb::splat(1.0 - self.internal)
         };
         albedo / denom
-            * (self.coat_transmittance(wo.z)
-                * self.coat_transmittance(wi.z)
-                * FRAC_1_PI
-                * wi.z
+            * (self.coat_transmittance(wo.z) * self.coat_transmittance(wi.z) * FRAC_1_PI * wi.z
                 / (self.eta * self.eta))
     }
 
@@ -264,7 +261,13 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Plastic, ParamEr
         ));
     }
     let diffuse = checked(ctx, &p.diffuse_reflectance, "diffuse_reflectance", 0.0, 1.0)?;
-    let specular = checked(ctx, &p.specular_reflectance, "specular_reflectance", 0.0, 1.0)?;
+    let specular = checked(
+        ctx,
+        &p.specular_reflectance,
+        "specular_reflectance",
+        0.0,
+        1.0,
+    )?;
     let d_mean = scalar(ctx.textures.mean(diffuse));
     let s_mean = scalar(ctx.textures.mean(specular));
     let specular_weight = if d_mean + s_mean > 0.0 {

@@ -212,17 +212,14 @@ impl Lobes {
 
 impl Principled {
     /// Calls `f` with the lobes of every point of the batch.
-    fn for_each(
-        &self,
-        ctx: &mut ShadeContext<'_>,
-        uv: &[Vec2],
-        mut f: impl FnMut(usize, &Lobes),
-    ) {
+    fn for_each(&self, ctx: &mut ShadeContext<'_>, uv: &[Vec2], mut f: impl FnMut(usize, &Lobes)) {
         let mut base = ctx.take::<Vec3>(uv.len());
         let mut scalars = ctx.take::<Vec3>(uv.len());
         {
-            let [b, m, r, s] =
-                ctx.lookup([self.base, self.metallic, self.roughness, self.specular], uv);
+            let [b, m, r, s] = ctx.lookup(
+                [self.base, self.metallic, self.roughness, self.specular],
+                uv,
+            );
             for i in 0..uv.len() {
                 base[i] = b[i];
                 scalars[i] = Vec3::new(scalar(m[i]), scalar(r[i]), scalar(s[i]));

@@ -92,7 +92,8 @@ fn oren_nayar(rho: Rgb, alpha: f32, wo: Vec3, wi: Vec3) -> Rgb {
     let tan_half = (sin_alpha + sin_beta)
         / ((1.0 - sin_alpha * sin_alpha).max(0.0).sqrt()
             + (1.0 - sin_beta * sin_beta).max(0.0).sqrt());
-    let single = rho * (c1 + cos_phi_diff * c2 * tan_beta + (1.0 - cos_phi_diff.abs()) * c3 * tan_half);
+    let single =
+        rho * (c1 + cos_phi_diff * c2 * tan_beta + (1.0 - cos_phi_diff.abs()) * c3 * tan_half);
     let double = rho * rho * (c4 * (1.0 - cos_phi_diff * tmp3 * tmp3));
     let value = (single + double).max(Rgb::ZERO) * (FRAC_1_PI * cos_i);
     if value.is_finite() { value } else { Rgb::ZERO }

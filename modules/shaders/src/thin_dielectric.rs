@@ -116,7 +116,13 @@ impl Shader for ThinDielectric {
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<ThinDielectric, ParamError> {
     let p: ThinParams = params.parse()?;
     let eta = relative_ior(&p.int_ior, &p.ext_ior, BK7)?;
-    let reflectance = checked(ctx, &p.specular_reflectance, "specular_reflectance", 0.0, 1.0)?;
+    let reflectance = checked(
+        ctx,
+        &p.specular_reflectance,
+        "specular_reflectance",
+        0.0,
+        1.0,
+    )?;
     let transmittance = checked(
         ctx,
         &p.specular_transmittance,

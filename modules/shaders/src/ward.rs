@@ -222,7 +222,13 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Ward, ParamError
         ));
     }
     let diffuse = checked(ctx, &p.diffuse_reflectance, "diffuse_reflectance", 0.0, 1.0)?;
-    let specular = checked(ctx, &p.specular_reflectance, "specular_reflectance", 0.0, 1.0)?;
+    let specular = checked(
+        ctx,
+        &p.specular_reflectance,
+        "specular_reflectance",
+        0.0,
+        1.0,
+    )?;
     let alpha_u = checked(ctx, &p.alpha_u, "alpha_u", MIN_ALPHA, 1.0)?;
     let alpha_v = checked(ctx, &p.alpha_v, "alpha_v", MIN_ALPHA, 1.0)?;
     Ok(Ward {
