@@ -65,3 +65,4 @@ pub fn check_against(image: &Image, reference: &Image, block: u32) -> ReferenceC
 }
 
 pub mod chi2;
+pub mod shading;

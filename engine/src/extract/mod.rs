@@ -8,6 +8,7 @@
 //! frame's effect set.
 
 mod lights;
+mod materials;
 mod shapes;
 
 pub use lights::LightTable;
@@ -18,6 +19,7 @@ use crate::world::{
     CameraPose, EmitterSpec, Geometry, LightSpec, MaterialRef, ModuleSpec, Transform,
 };
 use glam::{DMat4, UVec2, Vec2, Vec3};
+use materials::NestedMaterials;
 use radiant_core::registry::ModuleType;
 use radiant_core::{
     BuildContext, Camera, Effects, EmitterShape, Filter, Light, ModuleKind, Registry, Sampler,
@@ -165,6 +167,7 @@ pub fn extract(
     };
     let mut textures = TextureTable::default();
     let mut named_textures = HashMap::new();
+    let nested = NestedMaterials::new(registry, scene);
     macro_rules! ctx {
         ($shape:expr) => {
             BuildContext {
@@ -177,6 +180,7 @@ pub fn extract(
                 scene_dir: &scene.dir,
                 textures: &mut textures,
                 named_textures: &named_textures,
+                materials: Some(&nested),
             }
         };
     }
@@ -187,9 +191,11 @@ pub fn extract(
         named_textures.insert(name.clone(), id);
     }
     let mut shaders = Vec::with_capacity(scene.materials.len());
-    for (_, spec) in &scene.materials {
+    for (i, (_, spec)) in scene.materials.iter().enumerate() {
+        let _building = nested.enter(i);
         shaders.push(b.build::<dyn Shader>(spec, &mut ctx!(None))?);
     }
+    b.modules.append(&mut nested.used.borrow_mut());
 
     let mut prims: Vec<ShapePrim> = Vec::new();
     let mut material = Vec::new();

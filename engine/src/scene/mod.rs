@@ -40,7 +40,8 @@ use serde::Deserialize;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use yaml::{Mapping, closest, loc, module_spec, parse_node};
+pub(crate) use yaml::module_spec;
+use yaml::{Mapping, closest, loc, parse_node};
 
 /// How a frame is rendered: the scene's integrator, film and sampler
 /// settings (command-line options may override them).

@@ -1,8 +1,9 @@
 //! What a module sees while it is being built from its parameters.
 
 use crate::params::{Location, ParamError, Spanned, TextureInput};
-use crate::{TextureId, TextureTable};
+use crate::{Params, Shader, TextureId, TextureTable};
 use glam::{DVec3, Mat4, UVec2, Vec3};
+use marked_yaml::Node;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -59,12 +60,56 @@ pub struct BuildContext<'a> {
     pub textures: &'a mut TextureTable,
     /// Textures defined by name under `textures:`.
     pub named_textures: &'a HashMap<String, TextureId>,
+    /// Builds materials that a material refers to (for `blend`,
+    /// `normal_map`, `bump`); `None` where materials cannot nest.
+    pub materials: Option<&'a dyn MaterialSource>,
+}
+
+/// Builds the materials that other materials contain: a wrapper's nested
+/// material or the two materials a blend mixes. The engine implements it
+/// over the scene's `materials:` and the registry.
+pub trait MaterialSource {
+    /// Builds the material written at `node`: the name of a material
+    /// defined under `materials:` or an inline mapping with a `type`.
+    /// A material that contains itself is an error.
+    fn build_material(
+        &self,
+        node: &Node,
+        ctx: &mut BuildContext<'_>,
+    ) -> Result<Box<dyn Shader>, ParamError>;
 }
 
 impl BuildContext<'_> {
     /// Converts a world-space point to render space.
     pub fn to_render(&self, world: DVec3) -> Vec3 {
         (world - self.render_origin).as_vec3()
+    }
+
+    /// Builds the nested material under `key` of `params` (the name of a
+    /// material or an inline material). The module's own serde type should
+    /// accept the key (e.g. as `serde::de::IgnoredAny`) so that unknown-key
+    /// checking still works.
+    pub fn material(&mut self, params: &Params, key: &str) -> Result<Box<dyn Shader>, ParamError> {
+        let node = params
+            .node()
+            .as_mapping()
+            .and_then(|m| m.get_node(key))
+            .ok_or_else(|| ParamError {
+                message: format!(
+                    "missing `{key}`: expected the name of a material defined under `materials:` or an inline material such as `{{type: diffuse}}`"
+                ),
+                location: params.location_of(key),
+            })?;
+        self.material_at(node)
+    }
+
+    /// Builds the nested material written at `node` (see
+    /// [`material`](Self::material)); for lists of materials.
+    pub fn material_at(&mut self, node: &Node) -> Result<Box<dyn Shader>, ParamError> {
+        let source = self.materials.ok_or_else(|| {
+            ParamError::at(node.span(), "materials cannot be nested in this context")
+        })?;
+        source.build_material(node, self)
     }
 
     /// Resolves a colour parameter to a texture: inline values become

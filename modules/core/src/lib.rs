@@ -34,7 +34,7 @@ pub mod shader;
 pub mod texture;
 pub mod warp;
 
-pub use build::{BuildContext, EmitterShape};
+pub use build::{BuildContext, EmitterShape, MaterialSource};
 pub use camera::{Camera, CameraRays};
 pub use color::{Rgb, luminance};
 pub use effects::Effects;
@@ -44,7 +44,7 @@ pub use light::{EmitterEval, EmitterHit, Light, LightSample};
 pub use params::{Color, ParamError, Params, TextureInput};
 pub use registry::{ModuleInfo, ModuleKind, ParamDoc, Registry};
 pub use sampler::{SampleId, Sampler};
-pub use shader::{BsdfEval, BsdfSample, ShadeContext, Shader, SurfaceBatch};
+pub use shader::{BsdfEval, BsdfSample, Pooled, Scratch, ShadeContext, Shader, SurfaceBatch};
 pub use texture::{Texture, TextureId, TextureRef, TextureTable};
 
 pub use glam;

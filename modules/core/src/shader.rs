@@ -57,7 +57,41 @@ pub struct BsdfEval {
 pub struct ShadeContext<'a> {
     textures: &'a TextureTable,
     scratch: [Vec<Rgb>; 4],
+    pool: Scratch,
 }
+
+/// Free lists of buffers that shaders borrow with [`ShadeContext::take`]
+/// and give back with [`ShadeContext::recycle`]. Wrapper shaders (`blend`,
+/// `normal_map`, `bump`) gather sub-batches into them and layered shaders
+/// keep per-point parameters in them; nesting works because a buffer is
+/// moved out of the pool while it is in use.
+#[derive(Default)]
+pub struct Scratch {
+    vec3: Vec<Vec<Vec3>>,
+    vec2: Vec<Vec<Vec2>>,
+    float: Vec<Vec<f32>>,
+    index: Vec<Vec<u32>>,
+    samples: Vec<Vec<BsdfSample>>,
+    evals: Vec<Vec<BsdfEval>>,
+}
+
+/// Element types that [`ShadeContext::take`] can lend buffers of.
+pub trait Pooled: Copy + Default + 'static {
+    /// The free list of buffers of this type.
+    fn pool(scratch: &mut Scratch) -> &mut Vec<Vec<Self>>;
+}
+
+macro_rules! pooled {
+    ($($t:ty => $field:ident),*) => {$(
+        impl Pooled for $t {
+            fn pool(scratch: &mut Scratch) -> &mut Vec<Vec<Self>> {
+                &mut scratch.$field
+            }
+        }
+    )*};
+}
+
+pooled!(Vec3 => vec3, Vec2 => vec2, f32 => float, u32 => index, BsdfSample => samples, BsdfEval => evals);
 
 impl<'a> ShadeContext<'a> {
     /// Creates a context over the scene's textures.
@@ -65,7 +99,23 @@ impl<'a> ShadeContext<'a> {
         Self {
             textures,
             scratch: Default::default(),
+            pool: Scratch::default(),
         }
+    }
+
+    /// Borrows a buffer of `len` default values (colours are `Vec3`);
+    /// give it back with [`recycle`](Self::recycle) so that later batches
+    /// reuse its allocation.
+    pub fn take<T: Pooled>(&mut self, len: usize) -> Vec<T> {
+        let mut v = T::pool(&mut self.pool).pop().unwrap_or_default();
+        v.clear();
+        v.resize(len, T::default());
+        v
+    }
+
+    /// Returns a buffer obtained from [`take`](Self::take).
+    pub fn recycle<T: Pooled>(&mut self, buffer: Vec<T>) {
+        T::pool(&mut self.pool).push(buffer);
     }
 
     /// The scene's textures.

@@ -3,8 +3,36 @@
 //! In the wavefront, hits are sorted by material and each shader processes
 //! its whole slice: sampling continuation directions and evaluating the BSDF
 //! for next-event estimation.
+//!
+//! Shared maths: [`microfacet`] (GGX with visible-normal sampling),
+//! `fresnel`, `lobes` (GGX reflection and the rough dielectric interface
+//! used by several shaders), `perturb` (the frame of `normal_map` and
+//! `bump`), `inputs` (parameter helpers) and `metals` (complex indices of
+//! refraction).
+//!
+//! Emissive surfaces are not a shader: they are declared with an `emitter`
+//! (the `area` light) on the shape, so that next-event estimation can
+//! sample them and multiple importance sampling can weight their hits;
+//! an emission term on the BSDF would be invisible to light sampling.
 
+mod ashikhmin_shirley;
+mod blend;
+mod bump;
+mod conductor;
+mod dielectric;
 mod diffuse;
+mod fresnel;
+mod inputs;
+mod lobes;
+mod metals;
+pub mod microfacet;
+mod normal_map;
+mod perturb;
+mod plastic;
+mod principled;
+mod rough_diffuse;
+mod thin_dielectric;
+mod ward;
 
 pub use diffuse::Diffuse;
 
@@ -13,4 +41,15 @@ use radiant_core::Registry;
 /// Registers every built-in shader type.
 pub fn register(registry: &mut Registry) {
     diffuse::register(registry);
+    rough_diffuse::register(registry);
+    conductor::register(registry);
+    dielectric::register(registry);
+    thin_dielectric::register(registry);
+    plastic::register(registry);
+    principled::register(registry);
+    ashikhmin_shirley::register(registry);
+    ward::register(registry);
+    blend::register(registry);
+    normal_map::register(registry);
+    bump::register(registry);
 }

@@ -70,9 +70,10 @@ impl ImageTexture {
 
     #[inline]
     fn lookup(&self, uv: Vec2) -> Rgb {
-        // Continuous texel coordinates, rows from the top.
-        let x = uv.x * self.texels.width as f32;
-        let y = (1.0 - uv.y) * self.texels.height as f32;
+        // Continuous texel coordinates, rows from the top, kept finite and
+        // far from i64's limits so that the neighbour indices cannot overflow.
+        let x = texel_coordinate(uv.x * self.texels.width as f32);
+        let y = texel_coordinate((1.0 - uv.y) * self.texels.height as f32);
         match self.filtering {
             Filtering::Nearest => self.texel(x.floor() as i64, y.floor() as i64),
             Filtering::Bilinear => {
@@ -86,6 +87,14 @@ impl ImageTexture {
             }
         }
     }
+}
+
+/// Clamps a continuous texel coordinate to ±2⁴⁰ (NaN reads as 0): beyond
+/// that an `f32` has no fractional bits left, so no lookup changes.
+#[inline]
+fn texel_coordinate(c: f32) -> f32 {
+    const LIMIT: f32 = (1u64 << 40) as f32;
+    if c.is_nan() { 0.0 } else { c.clamp(-LIMIT, LIMIT) }
 }
 
 impl Texture for ImageTexture {
