@@ -2,9 +2,9 @@
 //! Cornell box converge to Mitsuba 3's renders of the same scenes.
 //!
 //! References: `tests/data/{glass,rough-metal,plastic}-mitsuba.exr`,
-//! Mitsuba 3 `llvm_ad_rgb` at 8192 spp, made by
+//! Mitsuba 3 `llvm_ad_rgb` at 8192 spp (64×64), made by
 //! `tests/reference/render_materials.py`, which builds the scenes
-//! `scenes/{glass,rough-metal,plastic}.yaml` describe (128×128, max_depth
+//! `scenes/{glass,rough-metal,plastic}.yaml` describe (64×64, max_depth
 //! 16). The comparison is that of `tests/cornell_box.rs`: channel means and
 //! 16×16 block means, with tolerances set from measured noise (see the
 //! constants), and each test shows that the check rejects a 3 % energy
@@ -51,6 +51,11 @@ fn compare(name: &str, mean_tol: f64, block_tol: f64) {
         );
     }
 }
+
+// Measured at 512 spp, seed 5: channel means within 0.22 % (glass),
+// 0.05 % (rough metal), 0.07 % (plastic); worst 16×16 block 3.2 % (glass
+// caustics), 1.4 %, 0.9 %. Tolerances: 1 % on means (a 3 % energy error
+// fails), 6 % on blocks.
 
 #[test]
 fn glass_matches_mitsuba() {
