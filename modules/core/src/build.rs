@@ -2,7 +2,7 @@
 
 use crate::params::{Location, ParamError, Spanned, TextureInput};
 use crate::{TextureId, TextureTable};
-use glam::{DVec3, Mat4, UVec2, Vec3};
+use glam::{DMat4, DVec3, Mat4, UVec2, Vec3};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -34,6 +34,15 @@ impl EmitterShape {
     }
 }
 
+/// A sphere that bounds the scene's geometry, in render space.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BoundingSphere {
+    /// Centre.
+    pub centre: Vec3,
+    /// Radius (positive even for an empty scene).
+    pub radius: f32,
+}
+
 /// Everything a module may need while it is built.
 ///
 /// *Render space* is world space translated so that the camera's position is
@@ -53,6 +62,14 @@ pub struct BuildContext<'a> {
     pub spp: u32,
     /// The shape an emitter is attached to (for lights declared on shapes).
     pub emitter_shape: Option<&'a EmitterShape>,
+    /// A light's own `transform` from the scene (light space to world
+    /// space); the identity when it has none and for every other module.
+    /// Lights apply it to their positions, directions and map frames.
+    pub to_world: DMat4,
+    /// A sphere bounding all geometry in render space, for lights
+    /// infinitely far away. Known only when free lights (the scene's
+    /// `lights:`) are built; zero-sized before that.
+    pub scene_sphere: BoundingSphere,
     /// Directory that relative paths in the scene are resolved against.
     pub scene_dir: &'a Path,
     /// The scene's texture table, to which textures are added.

@@ -11,7 +11,8 @@
 //! * the [`Effects`] a module declares, from which the engine decides which
 //!   light-transport features a scene needs;
 //! * the small shared maths every module uses: [`Frame`], sampling warps in
-//!   [`warp`], stateless hashing in [`hash`].
+//!   [`warp`], stateless hashing in [`hash`], piecewise-constant
+//!   distributions in [`distribution`].
 //!
 //! Data flow: the engine parses a scene, looks up each `type` in the
 //! [`Registry`], hands the module its [`Params`] and a [`BuildContext`], and
@@ -20,6 +21,7 @@
 pub mod build;
 pub mod camera;
 pub mod color;
+pub mod distribution;
 pub mod effects;
 pub mod filter;
 pub mod frame;
@@ -32,7 +34,7 @@ pub mod shader;
 pub mod texture;
 pub mod warp;
 
-pub use build::{BuildContext, EmitterShape};
+pub use build::{BoundingSphere, BuildContext, EmitterShape};
 pub use camera::{Camera, CameraRays};
 pub use color::{Rgb, luminance};
 pub use effects::Effects;

@@ -1,0 +1,172 @@
+//! Piecewise-constant distributions for sampling tabulated functions.
+//!
+//! A module that samples a tabulated function (a pixel filter's footprint,
+//! an environment map) builds one of these once, at build time, from
+//! non-negative cell weights; sampling is then two binary searches and no
+//! allocation.
+
+use glam::{UVec2, Vec2};
+
+/// A 1D piecewise-constant distribution over [0, 1) with `n` equal cells.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Distribution1D {
+    /// Cumulative probabilities, `n + 1` entries from 0 to 1.
+    cdf: Vec<f32>,
+    /// Sum of the weights.
+    total: f64,
+}
+
+impl Distribution1D {
+    /// A distribution proportional to `weights` (non-negative, finite; an
+    /// all-zero input gives the uniform distribution).
+    pub fn new(weights: &[f32]) -> Self {
+        let n = weights.len().max(1);
+        let total: f64 = weights.iter().map(|&w| w.max(0.0) as f64).sum();
+        let mut cdf = Vec::with_capacity(n + 1);
+        cdf.push(0.0);
+        let mut acc = 0.0f64;
+        for i in 0..n {
+            acc += if total > 0.0 {
+                weights.get(i).map_or(0.0, |&w| w.max(0.0) as f64) / total
+            } else {
+                1.0 / n as f64
+            };
+            cdf.push(acc as f32);
+        }
+        cdf[n] = 1.0;
+        Self { cdf, total }
+    }
+
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.cdf.len() - 1
+    }
+
+    /// Whether the distribution has no cells (never: an empty input gives
+    /// one uniform cell).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Sum of the weights it was built from.
+    pub fn total(&self) -> f64 {
+        self.total
+    }
+
+    /// Probability of cell `i`.
+    #[inline]
+    pub fn cell_probability(&self, i: usize) -> f32 {
+        self.cdf[i + 1] - self.cdf[i]
+    }
+
+    /// Samples a cell with `u` in [0, 1); returns the cell and `u`
+    /// re-scaled to [0, 1) within it.
+    #[inline]
+    pub fn sample(&self, u: f32) -> (usize, f32) {
+        let n = self.len();
+        let i = self.cdf.partition_point(|&c| c <= u).clamp(1, n) - 1;
+        let width = self.cdf[i + 1] - self.cdf[i];
+        let rest = if width > 0.0 {
+            ((u - self.cdf[i]) / width).clamp(0.0, 1.0 - f32::EPSILON / 2.0)
+        } else {
+            0.5
+        };
+        (i, rest)
+    }
+}
+
+/// A 2D piecewise-constant distribution over [0, 1)² with `size.x × size.y`
+/// equal cells: a marginal over rows and a conditional per row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Distribution2D {
+    size: UVec2,
+    rows: Vec<Distribution1D>,
+    marginal: Distribution1D,
+}
+
+impl Distribution2D {
+    /// A distribution proportional to `weights`, `size.x` per row, rows
+    /// from y = 0 up.
+    ///
+    /// # Panics
+    /// If `weights.len() != size.x * size.y`.
+    pub fn new(weights: &[f32], size: UVec2) -> Self {
+        assert_eq!(weights.len(), (size.x * size.y) as usize);
+        let rows: Vec<Distribution1D> = weights
+            .chunks_exact(size.x as usize)
+            .map(Distribution1D::new)
+            .collect();
+        let row_totals: Vec<f32> = rows.iter().map(|r| r.total() as f32).collect();
+        let marginal = Distribution1D::new(&row_totals);
+        Self {
+            size,
+            rows,
+            marginal,
+        }
+    }
+
+    /// Sum of all weights.
+    pub fn total(&self) -> f64 {
+        self.marginal.total()
+    }
+
+    /// Samples a point of [0, 1)²; returns it and its cell.
+    #[inline]
+    pub fn sample(&self, u: Vec2) -> (Vec2, UVec2) {
+        let (y, ry) = self.marginal.sample(u.y);
+        let (x, rx) = self.rows[y].sample(u.x);
+        let p = Vec2::new(
+            (x as f32 + rx) / self.size.x as f32,
+            (y as f32 + ry) / self.size.y as f32,
+        );
+        (p, UVec2::new(x as u32, y as u32))
+    }
+
+    /// Density (with respect to area on [0, 1)²) of cell `cell`.
+    #[inline]
+    pub fn pdf(&self, cell: UVec2) -> f32 {
+        self.marginal.cell_probability(cell.y as usize)
+            * self.rows[cell.y as usize].cell_probability(cell.x as usize)
+            * (self.size.x * self.size.y) as f32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_dimensional_cells_get_their_share() {
+        let d = Distribution1D::new(&[1.0, 0.0, 3.0]);
+        assert_eq!(d.total(), 4.0);
+        assert_eq!(d.sample(0.0).0, 0);
+        assert_eq!(d.sample(0.2).0, 0);
+        // The empty middle cell is never chosen.
+        assert_eq!(d.sample(0.25).0, 2);
+        let (i, r) = d.sample(0.625);
+        assert_eq!(i, 2);
+        assert!((r - 0.5).abs() < 1e-6);
+        assert!(d.sample(0.999_999).1 < 1.0);
+    }
+
+    #[test]
+    fn all_zero_weights_give_the_uniform_distribution() {
+        let d = Distribution1D::new(&[0.0; 4]);
+        assert_eq!(d.sample(0.6).0, 2);
+        assert!((d.cell_probability(1) - 0.25).abs() < 1e-7);
+    }
+
+    #[test]
+    fn two_dimensional_pdf_matches_weights() {
+        let w = [1.0, 2.0, 3.0, 0.0, 0.0, 2.0];
+        let d = Distribution2D::new(&w, UVec2::new(3, 2));
+        for (i, &wi) in w.iter().enumerate() {
+            let cell = UVec2::new(i as u32 % 3, i as u32 / 3);
+            let expected = wi / 8.0 * 6.0;
+            assert!((d.pdf(cell) - expected).abs() < 1e-6, "{cell}");
+        }
+        let (p, cell) = d.sample(Vec2::new(0.99, 0.99));
+        assert_eq!(cell, UVec2::new(2, 1));
+        assert!(p.x < 1.0 && p.y < 1.0 && p.y >= 0.5);
+    }
+}
