@@ -118,18 +118,21 @@ impl AreaLight {
     }
 
     /// Solid-angle density of sampling point `p` (normal `n`) of primitive
-    /// `prim` from `origin`; 0 if `p` faces away.
+    /// `prim` from `origin`; 0 if `p` faces away. (A sphere seen from
+    /// outside is only ever seen, and sampled, on its front cap, so its
+    /// density does not depend on the rounding of `n` at the silhouette.)
     #[inline]
     fn pdf(&self, prim: usize, origin: Vec3, p: Vec3, n: Vec3) -> f32 {
+        if let Some((_, _, cone)) = self.cone(prim, origin) {
+            return self.prim_probability(prim) * cone.pdf();
+        }
         let d = origin - p;
         let dist2 = d.length_squared();
         let cos_l = n.dot(d) / dist2.sqrt();
-        if !(cos_l > 0.0) {
-            return 0.0;
-        }
-        match self.cone(prim, origin) {
-            Some((_, _, cone)) => self.prim_probability(prim) * cone.pdf(),
-            None => dist2 / (cos_l * self.area),
+        if cos_l > 0.0 {
+            dist2 / (cos_l * self.area)
+        } else {
+            0.0
         }
     }
 }
