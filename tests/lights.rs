@@ -119,7 +119,12 @@ fn environment_samples_agree_with_eval_and_lie_outside_the_scene() {
         let close = |a: f32, b: f32| (a - b).abs() <= 2e-3 * a.abs().max(b.abs()) + 1e-6;
         assert!(close(e.pdf, s.pdf), "pdf {} vs eval {}", s.pdf, e.pdf);
         for c in 0..3 {
-            assert!(close(e.radiance[c], s.radiance[c]), "{} vs {}", s.radiance, e.radiance);
+            assert!(
+                close(e.radiance[c], s.radiance[c]),
+                "{} vs {}",
+                s.radiance,
+                e.radiance
+            );
         }
     }
 }
@@ -142,7 +147,10 @@ fn environment_power_is_pi_r2_times_the_integral_of_luminance() {
     let integral = sum * 4.0 * std::f64::consts::PI / (2 * n * n) as f64;
     let expected = std::f64::consts::PI * integral;
     let power = light.power() as f64;
-    assert!((power / expected - 1.0).abs() < 0.02, "{power} vs {expected}");
+    assert!(
+        (power / expected - 1.0).abs() < 0.02,
+        "{power} vs {expected}"
+    );
 }
 
 #[test]
@@ -176,10 +184,7 @@ fn distribution_2d_sampling_matches_its_pdf() {
             phi += TAU;
         }
         let (u, v) = (phi / TAU, (1.0 - d.z as f64) / 2.0);
-        let cell = UVec2::new(
-            ((u * 7.0) as u32).min(6),
-            ((v * 5.0) as u32).min(4),
-        );
+        let cell = UVec2::new(((u * 7.0) as u32).min(6), ((v * 5.0) as u32).min(4));
         dist.pdf(cell) as f64 / (4.0 * PI)
     };
     let cfg = Chi2 {
