@@ -80,7 +80,63 @@ fn light_pdf(light: &dyn Light, shape: &Accel, origin: Vec3, d: Vec3) -> f64 {
     e[0].pdf as f64
 }
 
+/// Stretches polar angles about `axis` by `k` (θ → kθ), so that a small
+/// cone of directions covers many cells of the chi-square grid.
+#[derive(Clone, Copy)]
+struct Magnify {
+    frame: radiant_core::Frame,
+    k: f32,
+}
+
+impl Magnify {
+    fn new(axis: Vec3, k: f32) -> Self {
+        Self {
+            frame: radiant_core::Frame::from_normal(axis),
+            k,
+        }
+    }
+
+    fn forward(&self, d: Vec3) -> Vec3 {
+        let l = self.frame.to_local(d);
+        // atan2 rather than acos: precise for the small angles magnified.
+        let theta = l.truncate().length().atan2(l.z) * self.k;
+        let phi = l.y.atan2(l.x);
+        self.frame.to_world(Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        ))
+    }
+
+    /// The original direction of `d` and the factor dω / dω' on densities.
+    fn inverse(&self, d: Vec3) -> Option<(Vec3, f64)> {
+        let l = self.frame.to_local(d);
+        let theta_m = l.truncate().length().atan2(l.z);
+        let theta = theta_m / self.k;
+        if theta_m >= std::f32::consts::PI * 0.999 || theta_m < 1e-7 {
+            return None;
+        }
+        let phi = l.y.atan2(l.x);
+        let orig = self.frame.to_world(Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        ));
+        let jac = theta.sin() as f64 / (self.k as f64 * theta_m.sin() as f64);
+        Some((orig, jac))
+    }
+}
+
 fn check_light(shape: EmitterShape, origin: Vec3, refine: usize) {
+    check_light_magnified(shape, origin, refine, None);
+}
+
+fn check_light_magnified(
+    shape: EmitterShape,
+    origin: Vec3,
+    refine: usize,
+    magnify: Option<Magnify>,
+) {
     let light = radiant_lights::AreaLight::new(Rgb::ONE, shape.clone()).unwrap();
     let mut prims: Vec<Primitive> = shape
         .triangles
@@ -107,11 +163,27 @@ fn check_light(shape: EmitterShape, origin: Vec3, refine: usize) {
             .filter(|d| {
                 accel
                     .intersect(origin, *d, f32::INFINITY)
-                    .is_some_and(|h| (origin + *d * h.t - s.p).length() < 1e-3)
+                    .is_some_and(|h| (origin + *d * h.t - s.p).length() < 1e-3 * h.t.max(1.0))
+            })
+            .and_then(|d| match magnify {
+                None => Some(d),
+                // Keep the sample only if the magnified direction maps back
+                // onto the shape (directions at the silhouette may not).
+                Some(m) => {
+                    let f = m.forward(d);
+                    m.inverse(f)
+                        .is_some_and(|(o, _)| accel.intersect(origin, o, f32::INFINITY).is_some())
+                        .then_some(f)
+                }
             })
     });
-    cfg.run(samples, |d| light_pdf(&light, &accel, origin, d))
-        .unwrap();
+    cfg.run(samples, |d| match magnify {
+        None => light_pdf(&light, &accel, origin, d),
+        Some(m) => m.inverse(d).map_or(0.0, |(orig, jac)| {
+            light_pdf(&light, &accel, origin, orig) * jac
+        }),
+    })
+    .unwrap();
 }
 
 #[test]
@@ -147,6 +219,54 @@ fn area_light_sampling_matches_its_pdf_on_spheres() {
         spheres: vec![(Vec3::new(0.1, 0.2, 1.3), 1.0)],
     };
     check_light(shape, Vec3::ZERO, 64);
+}
+
+#[test]
+fn sphere_light_solid_angle_sampling_from_just_outside() {
+    let (centre, r) = (Vec3::new(0.1, 0.2, 1.3), 1.0);
+    let sphere = || EmitterShape {
+        triangles: vec![],
+        spheres: vec![(centre, r)],
+    };
+    // Just outside the surface: the cone is almost a hemisphere.
+    let near = centre + Vec3::new(0.3, -0.5, -0.8).normalize() * (r * 1.01);
+    check_light(sphere(), near, 64);
+}
+
+#[test]
+fn sphere_light_solid_angle_sampling_from_far_away() {
+    let (centre, r) = (Vec3::new(0.1, 0.2, 1.3), 1.0);
+    let sphere = || EmitterShape {
+        triangles: vec![],
+        spheres: vec![(centre, r)],
+    };
+    // 20 radii away (sin²θmax = 1/400) and 300 radii away (the Taylor
+    // branch below 1.5°): the cones are magnified to cover the grid.
+    for dist in [20.0f32, 300.0] {
+        let axis = Vec3::new(-0.2, 0.3, 1.0).normalize();
+        let origin = centre - axis * dist;
+        let theta_max = (r / dist).asin();
+        let k = 0.8 * std::f32::consts::PI / theta_max;
+        check_light_magnified(sphere(), origin, 32, Some(Magnify::new(axis, k)));
+    }
+}
+
+#[test]
+fn triangle_light_sampling_at_grazing_angles() {
+    // The reference point is 0.1 above the plane of a large triangle, so
+    // most of the light is seen at grazing angles (cos θ at the light down
+    // to 0.02); the density is steep near the horizon, hence the fine
+    // integration grid.
+    let shape = EmitterShape {
+        triangles: vec![[
+            Vec3::new(-2.0, 0.0, -2.0),
+            Vec3::new(3.0, 0.0, -2.0),
+            Vec3::new(-2.0, 0.0, 3.0),
+        ]],
+        spheres: vec![],
+    };
+    // Normal (b − a) × (c − a) points to −y; look from below.
+    check_light(shape, Vec3::new(0.0, -0.1, 0.0), 128);
 }
 
 #[test]

@@ -199,3 +199,70 @@ fn a_scene_without_camera_is_an_error() {
     let err = load("shapes: []\n").unwrap_err();
     assert!(err.to_string().contains("needs a `camera`"), "{err}");
 }
+
+#[test]
+fn bad_light_parameters_are_located_and_explained() {
+    let light = |l: &str| format!("{CAMERA}lights:\n  - {l}\n");
+    fails_at(
+        &light("{type: environment, radiance: 1, filename: sky.exr}"),
+        3,
+        &["either a `filename`", "or a constant `radiance`"],
+    );
+    fails_at(&light("{type: environment}"), 3, &["either a `filename`"]);
+    fails_at(
+        &light("{type: environment, filename: missing.exr}"),
+        3,
+        &["missing.exr", "cannot read the environment map"],
+    );
+    fails_at(
+        &light("{type: environment, filename: cornell-box.yaml}"),
+        3,
+        &["must end in .exr or .hdr"],
+    );
+    fails_at(
+        &light("{type: environment, radiance: 1, transform: {scale: 2}}"),
+        3,
+        &["must be a rotation"],
+    );
+    fails_at(
+        &light("{type: environment, radiance: [1, -1, 1]}"),
+        3,
+        &["`radiance` must be finite and non-negative"],
+    );
+    fails_at(
+        &light("{type: environment, radiance: 1, scale: -2}"),
+        3,
+        &["`scale` must be finite and non-negative"],
+    );
+    fails_at(
+        &light("{type: spot, intensity: 1, cutoff_angle: 20, beam_width: 30}"),
+        3,
+        &["`beam_width` must be in [0, cutoff_angle = 20]"],
+    );
+    fails_at(
+        &light("{type: spot, intensity: 1, cutoff_angle: 0}"),
+        3,
+        &["`cutoff_angle` must be in (0, 180]"],
+    );
+    fails_at(
+        &light("{type: spot, intensity: 1, position: [1, 1, 1], target: [1, 1, 1]}"),
+        3,
+        &["`target` must differ from `position`"],
+    );
+    fails_at(
+        &light("{type: spot, intensity: 1, direction: [0, 0, 1], target: [1, 1, 1]}"),
+        3,
+        &["either `direction` or `target`"],
+    );
+    fails_at(
+        &light("{type: directional, irradiance: 1, direction: [0, 0, 0]}"),
+        3,
+        &["`direction` must be a finite, non-zero vector"],
+    );
+    fails_at(&light("{type: directional}"), 3, &["irradiance"]);
+    fails_at(
+        &light("{type: point, intensity: 1, position: [0, 0, 0], transform: {rotate: 5}}"),
+        3,
+        &[],
+    );
+}

@@ -66,3 +66,42 @@ pub fn check_against(image: &Image, reference: &Image, block: u32) -> ReferenceC
 
 pub mod chi2;
 pub mod shading;
+
+/// Tolerances of a comparison with a converged reference.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerances {
+    /// Allowed |mean ratio − 1| per colour channel.
+    pub channel_mean: f64,
+    /// Allowed relative error of a block mean.
+    pub block: f64,
+}
+
+impl Tolerances {
+    /// Whether `check` is within these tolerances.
+    pub fn passes(&self, check: &ReferenceCheck) -> bool {
+        check.worst_channel_mean_error < self.channel_mean && check.worst_block_error < self.block
+    }
+
+    /// Asserts that `image` matches `reference` (blocks of `block` pixels)
+    /// and that the same comparison rejects the image with 3 % too little or
+    /// too much energy, so the tolerances have power.
+    pub fn assert_matches(&self, image: &Image, reference: &Image, block: u32) {
+        let check = check_against(image, reference, block);
+        eprintln!("{check:?}");
+        assert!(
+            self.passes(&check),
+            "render differs from the reference: {check:?}"
+        );
+        for scale in [0.97f32, 1.03] {
+            let scaled = Image {
+                pixels: image.pixels.iter().map(|p| *p * scale).collect(),
+                ..image.clone()
+            };
+            let check = check_against(&scaled, reference, block);
+            assert!(
+                !self.passes(&check),
+                "a {scale}× energy error went unnoticed: {check:?}"
+            );
+        }
+    }
+}

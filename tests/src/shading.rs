@@ -3,7 +3,7 @@
 //! nested materials), evaluated one direction at a time; and the zoom map
 //! that lets the chi-square test resolve very narrow lobes.
 
-use glam::{DVec3, Mat4, UVec2, Vec2, Vec3};
+use glam::{DVec3, UVec2, Vec2, Vec3};
 use radiant_core::registry::Registry;
 use radiant_core::{
     BsdfEval, BsdfSample, BuildContext, Frame, MaterialSource, ParamError, Params, Rgb,
@@ -87,18 +87,9 @@ pub fn build(yaml: &str) -> Result<TestShader, ParamError> {
     let node = Params::from_yaml(yaml)?;
     let (ty, params) = split_type(node.node())?;
     let source = Inline(&registry);
-    let mut ctx = BuildContext {
-        resolution: UVec2::ONE,
-        camera_to_render: Mat4::IDENTITY,
-        render_origin: DVec3::ZERO,
-        seed: 0,
-        spp: 1,
-        emitter_shape: None,
-        scene_dir: Path::new("."),
-        textures: &mut textures,
-        named_textures: &named,
-        materials: Some(&source),
-    };
+    let mut ctx = BuildContext::standalone(Path::new("."), &mut textures, &named);
+    ctx.resolution = UVec2::ONE;
+    ctx.materials = Some(&source);
     let shader = registry
         .build::<dyn Shader>(&ty, &params, &mut ctx)
         .map_err(|e| match e {

@@ -1,7 +1,7 @@
 //! The light table: every light of the frame and the distribution that
 //! chooses one per next-event estimate, proportional to power.
 
-use radiant_core::Light;
+use radiant_core::{Effects, Light};
 
 /// The scene's lights with their selection probabilities.
 #[derive(Default)]
@@ -10,6 +10,7 @@ pub struct LightTable {
     cdf: Vec<f32>,
     pmf: Vec<f32>,
     delta: Vec<bool>,
+    environment: Vec<usize>,
 }
 
 impl LightTable {
@@ -41,11 +42,15 @@ impl LightTable {
             *last = 1.0;
         }
         let delta = lights.iter().map(|l| l.is_delta()).collect();
+        let environment = (0..lights.len())
+            .filter(|&i| lights[i].effects().contains(Effects::ENVIRONMENT))
+            .collect();
         Self {
             lights,
             cdf,
             pmf,
             delta,
+            environment,
         }
     }
 
@@ -88,6 +93,12 @@ impl LightTable {
         self.delta[i]
     }
 
+    /// Indices of the lights that rays leaving the scene can reach (those
+    /// whose effects contain [`Effects::ENVIRONMENT`]).
+    pub fn environment(&self) -> &[usize] {
+        &self.environment
+    }
+
     /// Probability of choosing light `i`.
     #[inline]
     pub fn pmf(&self, i: usize) -> f32 {
@@ -98,8 +109,8 @@ impl LightTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use radiant_core::LightSample;
     use radiant_core::glam::{Vec2, Vec3};
-    use radiant_core::{Effects, LightSample};
 
     struct Fixed(f32);
     impl Light for Fixed {

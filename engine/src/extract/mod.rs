@@ -22,8 +22,8 @@ use glam::{DMat4, UVec2, Vec2, Vec3};
 use materials::NestedMaterials;
 use radiant_core::registry::ModuleType;
 use radiant_core::{
-    BuildContext, Camera, Effects, EmitterShape, Filter, Light, ModuleKind, Registry, Sampler,
-    Shader, Texture, TextureTable,
+    BoundingSphere, BuildContext, Camera, Effects, EmitterShape, Filter, Light, ModuleKind,
+    Registry, Sampler, Shader, Texture, TextureTable,
 };
 use shapes::{ShapePrim, tessellate};
 use std::collections::{BTreeSet, HashMap};
@@ -168,8 +168,12 @@ pub fn extract(
     let mut textures = TextureTable::default();
     let mut named_textures = HashMap::new();
     let nested = NestedMaterials::new(registry, scene);
+    let mut scene_sphere = BoundingSphere::default();
     macro_rules! ctx {
         ($shape:expr) => {
+            ctx!($shape, DMat4::IDENTITY)
+        };
+        ($shape:expr, $to_world:expr) => {
             BuildContext {
                 resolution: UVec2::new(settings.width, settings.height),
                 camera_to_render,
@@ -177,6 +181,8 @@ pub fn extract(
                 seed: settings.seed,
                 spp: settings.spp,
                 emitter_shape: $shape,
+                to_world: $to_world,
+                scene_sphere,
                 scene_dir: &scene.dir,
                 textures: &mut textures,
                 named_textures: &named_textures,
@@ -255,9 +261,10 @@ pub fn extract(
         }
     }
     drop(query);
-    let mut light_query = scene.world.query::<&LightSpec>();
-    for LightSpec(spec) in light_query.iter() {
-        lights.push(b.build::<dyn Light>(spec, &mut ctx!(None))?);
+    scene_sphere = bounding_sphere(&prims);
+    let mut light_query = scene.world.query::<(&LightSpec, &Transform)>();
+    for (LightSpec(spec), transform) in light_query.iter() {
+        lights.push(b.build::<dyn Light>(spec, &mut ctx!(None, transform.0))?);
     }
     drop(light_query);
 
@@ -317,4 +324,35 @@ pub fn extract(
         modules: b.modules,
         stats,
     })
+}
+
+/// A sphere around the bounding box of `prims` (Mitsuba's convention,
+/// enlarged slightly), with a positive radius even for an empty scene.
+fn bounding_sphere(prims: &[ShapePrim]) -> BoundingSphere {
+    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for p in prims {
+        match *p {
+            ShapePrim::Triangle { v, .. } => {
+                for x in v {
+                    lo = lo.min(x);
+                    hi = hi.max(x);
+                }
+            }
+            ShapePrim::Sphere { centre, radius } => {
+                lo = lo.min(centre - radius);
+                hi = hi.max(centre + radius);
+            }
+        }
+    }
+    if !(lo.cmple(hi).all()) {
+        return BoundingSphere {
+            centre: Vec3::ZERO,
+            radius: 1.0,
+        };
+    }
+    let centre = 0.5 * (lo + hi);
+    BoundingSphere {
+        centre,
+        radius: ((hi - centre).length() * (1.0 + 1e-3)).max(1e-3),
+    }
 }

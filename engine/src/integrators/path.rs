@@ -95,6 +95,10 @@ pub struct Wavefront {
     em_slots: Vec<u32>,
     em_hits: Vec<EmitterHit>,
     em_evals: Vec<EmitterEval>,
+    // Rays that left the scene (environment lights).
+    esc_slots: Vec<u32>,
+    esc_dirs: Vec<Vec3>,
+    esc_evals: Vec<EmitterEval>,
     // Shadow rays.
     shadow_slot: Vec<u32>,
     shadow_origin: Vec<Vec3>,
@@ -120,6 +124,18 @@ fn zeroed<T: Clone + Default>(v: &mut Vec<T>, n: usize) {
 fn power_heuristic(a: f32, b: f32) -> f32 {
     let (a2, b2) = (a * a, b * b);
     if a2 + b2 > 0.0 { a2 / (a2 + b2) } else { 0.0 }
+}
+
+/// MIS weight of emission found by a BSDF-sampled ray (density `bsdf_pdf`,
+/// 0 for delta lobes) against light sampling with density `light_pdf`
+/// (selection probability included). Camera rays (depth 0) take it whole.
+#[inline]
+fn bsdf_hit_weight(depth: u32, bsdf_pdf: f32, light_pdf: f32) -> f32 {
+    if depth == 0 || bsdf_pdf == 0.0 {
+        1.0
+    } else {
+        power_heuristic(bsdf_pdf, light_pdf)
+    }
 }
 
 impl Wavefront {
@@ -205,10 +221,14 @@ impl Wavefront {
         };
         let has_lights = !scene.lights.is_empty();
         let has_area = scene.effects.contains(Effects::AREA_LIGHTS);
+        let has_env = !scene.lights.environment().is_empty();
         let mut depth = 0u32;
         while !self.live.is_empty() {
             self.trace_closest(scene);
-            self.resolve_hits(scene, depth, has_area);
+            self.resolve_hits(scene, depth, has_area, has_env);
+            if has_env {
+                self.add_escaped(scene, depth);
+            }
             if depth + 1 >= max_depth {
                 break;
             }
@@ -242,14 +262,19 @@ impl Wavefront {
         self.rays += self.live.len() as u64;
     }
 
-    /// Drops paths that escaped, resolves hits, adds emission.
-    fn resolve_hits(&mut self, scene: &RenderScene, depth: u32, has_area: bool) {
+    /// Drops paths that escaped (keeping them in `esc_slots` if `has_env`),
+    /// resolves hits, adds emission.
+    fn resolve_hits(&mut self, scene: &RenderScene, depth: u32, has_area: bool, has_env: bool) {
         self.em_slots.clear();
+        self.esc_slots.clear();
         self.next_live.clear();
         for &slot in &self.live {
             let i = slot as usize;
             let hit = self.hit[i];
             if hit.prim == u32::MAX {
+                if has_env {
+                    self.esc_slots.push(slot);
+                }
                 continue;
             }
             self.its[i] = interaction(scene, &hit, self.origin[i], self.dir[i]);
@@ -299,11 +324,30 @@ impl Wavefront {
             for k in self.offsets[light] as usize..self.offsets[light + 1] as usize {
                 let i = self.em_slots[k] as usize;
                 let e = self.em_evals[k];
-                let w = if depth == 0 || self.prev_pdf[i] == 0.0 {
-                    1.0
-                } else {
-                    power_heuristic(self.prev_pdf[i], pmf * e.pdf)
-                };
+                let w = bsdf_hit_weight(depth, self.prev_pdf[i], pmf * e.pdf);
+                self.radiance[i] += self.beta[i] * e.radiance * w;
+            }
+        }
+    }
+
+    /// Adds the emission of environment lights to the paths that left the
+    /// scene this bounce, one `Light::eval_escaped` call per such light.
+    fn add_escaped(&mut self, scene: &RenderScene, depth: u32) {
+        let n = self.esc_slots.len();
+        if n == 0 {
+            return;
+        }
+        fit(&mut self.esc_dirs, n);
+        fit(&mut self.esc_evals, n);
+        for (d, &slot) in self.esc_dirs.iter_mut().zip(&self.esc_slots) {
+            *d = self.dir[slot as usize].normalize();
+        }
+        for &light in scene.lights.environment() {
+            scene.lights.lights()[light].eval_escaped(&self.esc_dirs, &mut self.esc_evals);
+            let pmf = scene.lights.pmf(light);
+            for (&slot, e) in self.esc_slots.iter().zip(&self.esc_evals) {
+                let i = slot as usize;
+                let w = bsdf_hit_weight(depth, self.prev_pdf[i], pmf * e.pdf);
                 self.radiance[i] += self.beta[i] * e.radiance * w;
             }
         }

@@ -159,7 +159,12 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
             )
         })?;
         for node in seq.iter() {
-            world.spawn((LightSpec(module_spec(file, node, "light", &[])?),));
+            let spec = LightSpec(module_spec(file, node, "light", &["transform"])?);
+            let transform = match node.as_mapping().and_then(|m| m.get_node("transform")) {
+                Some(t) => transform::parse_transform(file, t)?,
+                None => DMat4::IDENTITY,
+            };
+            world.spawn((spec, Transform(transform)));
         }
     }
     top.finish(TOP_KEYS)?;

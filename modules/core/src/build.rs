@@ -2,7 +2,7 @@
 
 use crate::params::{Location, ParamError, Spanned, TextureInput};
 use crate::{Params, Shader, TextureId, TextureTable};
-use glam::{DVec3, Mat4, UVec2, Vec3};
+use glam::{DMat4, DVec3, Mat4, UVec2, Vec3};
 use marked_yaml::Node;
 use std::collections::HashMap;
 use std::path::Path;
@@ -35,6 +35,15 @@ impl EmitterShape {
     }
 }
 
+/// A sphere that bounds the scene's geometry, in render space.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BoundingSphere {
+    /// Centre.
+    pub centre: Vec3,
+    /// Radius (positive even for an empty scene).
+    pub radius: f32,
+}
+
 /// Everything a module may need while it is built.
 ///
 /// *Render space* is world space translated so that the camera's position is
@@ -54,6 +63,14 @@ pub struct BuildContext<'a> {
     pub spp: u32,
     /// The shape an emitter is attached to (for lights declared on shapes).
     pub emitter_shape: Option<&'a EmitterShape>,
+    /// A light's own `transform` from the scene (light space to world
+    /// space); the identity when it has none and for every other module.
+    /// Lights apply it to their positions, directions and map frames.
+    pub to_world: DMat4,
+    /// A sphere bounding all geometry in render space, for lights
+    /// infinitely far away. Known only when free lights (the scene's
+    /// `lights:`) are built; zero-sized before that.
+    pub scene_sphere: BoundingSphere,
     /// Directory that relative paths in the scene are resolved against.
     pub scene_dir: &'a Path,
     /// The scene's texture table, to which textures are added.
@@ -79,7 +96,36 @@ pub trait MaterialSource {
     ) -> Result<Box<dyn Shader>, ParamError>;
 }
 
-impl BuildContext<'_> {
+impl<'a> BuildContext<'a> {
+    /// A context for building modules outside a scene (tools, tests,
+    /// outside crates): an 8×8 film, the camera at the world origin looking
+    /// down +z, seed 0, one sample per pixel, identity transforms, a unit
+    /// scene sphere and no nested materials. Set the public fields to
+    /// change any of them.
+    pub fn standalone(
+        scene_dir: &'a Path,
+        textures: &'a mut TextureTable,
+        named_textures: &'a HashMap<String, TextureId>,
+    ) -> Self {
+        BuildContext {
+            resolution: UVec2::new(8, 8),
+            camera_to_render: Mat4::IDENTITY,
+            render_origin: DVec3::ZERO,
+            seed: 0,
+            spp: 1,
+            emitter_shape: None,
+            to_world: DMat4::IDENTITY,
+            scene_sphere: BoundingSphere {
+                centre: Vec3::ZERO,
+                radius: 1.0,
+            },
+            scene_dir,
+            textures,
+            named_textures,
+            materials: None,
+        }
+    }
+
     /// Converts a world-space point to render space.
     pub fn to_render(&self, world: DVec3) -> Vec3 {
         (world - self.render_origin).as_vec3()

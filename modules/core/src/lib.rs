@@ -34,7 +34,7 @@ pub mod shader;
 pub mod texture;
 pub mod warp;
 
-pub use build::{BuildContext, EmitterShape, MaterialSource};
+pub use build::{BoundingSphere, BuildContext, EmitterShape, MaterialSource};
 pub use camera::{Camera, CameraRays};
 pub use color::{Rgb, luminance};
 pub use effects::Effects;

@@ -5,7 +5,14 @@
 //! [`Light::sample`] once per group. Rays that hit an emissive surface are
 //! likewise grouped and passed to [`Light::eval_hits`], which returns the
 //! emitted radiance and the density with which `sample` would have produced
-//! that point, for multiple importance sampling.
+//! that point, for multiple importance sampling. Rays that leave the scene
+//! are passed, per light whose effects contain [`Effects::ENVIRONMENT`], to
+//! [`Light::eval_escaped`].
+//!
+//! Lights infinitely far away (environment, directional) place their
+//! next-event sample points outside the scene's bounding sphere
+//! ([`BuildContext::scene_sphere`](crate::BuildContext::scene_sphere)):
+//! `p = reference + direction · 2r`, with `n = 0`.
 
 use crate::{Effects, Rgb};
 use glam::{Vec2, Vec3};
@@ -65,6 +72,15 @@ pub trait Light: Send + Sync {
     /// without surfaces are never hit, so the default writes nothing.
     fn eval_hits(&self, hits: &[EmitterHit], out: &mut [EmitterEval]) {
         out[..hits.len()].fill(EmitterEval::default());
+    }
+
+    /// Evaluates emission for rays that left the scene in the unit
+    /// directions `dirs` (render space): the radiance arriving along `-dirs[i]`
+    /// and the solid-angle density with which [`sample`](Self::sample) picks
+    /// that direction. Only lights whose effects contain
+    /// [`Effects::ENVIRONMENT`] are asked; the default writes zeros.
+    fn eval_escaped(&self, dirs: &[Vec3], out: &mut [EmitterEval]) {
+        out[..dirs.len()].fill(EmitterEval::default());
     }
 
     /// Effects this light needs.

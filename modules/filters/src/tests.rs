@@ -3,7 +3,7 @@
 //! their location.
 
 use super::*;
-use radiant_core::glam::{DVec3, Mat4, UVec2};
+
 use radiant_core::{BuildContext, Filter, Params, TextureTable};
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -155,17 +155,7 @@ fn build(ty: &str, yaml: &str) -> Result<Box<dyn Filter>, radiant_core::registry
     register(&mut registry);
     let mut textures = TextureTable::default();
     let named = HashMap::new();
-    let mut ctx = BuildContext {
-        resolution: UVec2::new(8, 8),
-        camera_to_render: Mat4::IDENTITY,
-        render_origin: DVec3::ZERO,
-        seed: 0,
-        spp: 1,
-        emitter_shape: None,
-        scene_dir: std::path::Path::new("."),
-        textures: &mut textures,
-        named_textures: &named,
-    };
+    let mut ctx = BuildContext::standalone(std::path::Path::new("."), &mut textures, &named);
     let params = Params::from_yaml(yaml).expect("test YAML parses");
     registry.build::<dyn Filter>(ty, &params, &mut ctx)
 }

@@ -1,5 +1,12 @@
 //! The `area` light: uniform, one-sided diffuse emission from a shape.
+//!
+//! Next-event estimation picks a primitive in proportion to its area, then
+//! a point on it: uniformly by area on triangles, and on spheres uniformly
+//! in the solid angle the sphere subtends when the reference point is
+//! outside it (uniformly by area from inside). `eval_hits` returns the
+//! density of the same strategy for the primitive that was hit.
 
+use crate::sphere::Cone;
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::warp::{square_to_uniform_sphere, square_to_uniform_triangle};
 use radiant_core::{
@@ -22,7 +29,8 @@ const DOCS: &[ParamDoc] = &[ParamDoc {
 }];
 
 /// Diffuse emission from the front side (the side the normal points to) of
-/// every primitive of a shape. Points are sampled uniformly by area.
+/// every primitive of a shape. Points are sampled uniformly by area, or by
+/// solid angle on spheres seen from outside.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AreaLight {
     radiance: Rgb,
@@ -75,6 +83,25 @@ impl AreaLight {
         (i, rescaled)
     }
 
+    /// Probability of picking primitive `prim`.
+    #[inline]
+    fn prim_probability(&self, prim: usize) -> f32 {
+        let lo = if prim == 0 { 0.0 } else { self.cdf[prim - 1] };
+        (self.cdf[prim] - lo) / self.area
+    }
+
+    /// The sphere primitive `prim` with its subtended cone from `origin`,
+    /// if `prim` is a sphere and `origin` lies outside it.
+    #[inline]
+    fn cone(&self, prim: usize, origin: Vec3) -> Option<(Vec3, f32, Cone)> {
+        let (centre, r) = *self
+            .shape
+            .spheres
+            .get(prim.checked_sub(self.shape.triangles.len())?)?;
+        Cone::new(centre, r, origin).map(|cone| (centre, r, cone))
+    }
+
+    /// A point and normal on primitive `prim`, uniformly by area.
     #[inline]
     fn point_on(&self, prim: usize, u: Vec2) -> (Vec3, Vec3) {
         let ntri = self.shape.triangles.len();
@@ -89,6 +116,25 @@ impl AreaLight {
             (centre + n * r, n)
         }
     }
+
+    /// Solid-angle density of sampling point `p` (normal `n`) of primitive
+    /// `prim` from `origin`; 0 if `p` faces away. (A sphere seen from
+    /// outside is only ever seen, and sampled, on its front cap, so its
+    /// density does not depend on the rounding of `n` at the silhouette.)
+    #[inline]
+    fn pdf(&self, prim: usize, origin: Vec3, p: Vec3, n: Vec3) -> f32 {
+        if let Some((_, _, cone)) = self.cone(prim, origin) {
+            return self.prim_probability(prim) * cone.pdf();
+        }
+        let d = origin - p;
+        let dist2 = d.length_squared();
+        let cos_l = n.dot(d) / dist2.sqrt();
+        if cos_l > 0.0 {
+            dist2 / (cos_l * self.area)
+        } else {
+            0.0
+        }
+    }
 }
 
 impl Light for AreaLight {
@@ -101,19 +147,20 @@ impl Light for AreaLight {
     }
 
     fn sample(&self, refs: &[Vec3], u: &[Vec2], out: &mut [LightSample]) {
-        let pdf_area = 1.0 / self.area;
         for ((r, u), o) in refs.iter().zip(u).zip(out.iter_mut()) {
             let (prim, ux) = self.pick(u.x);
-            let (p, n) = self.point_on(prim, Vec2::new(ux, u.y));
-            let d = p - *r;
-            let dist2 = d.length_squared();
-            let cos_l = -n.dot(d) / dist2.sqrt();
-            *o = if cos_l > 0.0 && dist2 > 0.0 {
+            let u = Vec2::new(ux, u.y);
+            let (p, n) = match self.cone(prim, *r) {
+                Some((centre, radius, cone)) => cone.sample(centre, radius, *r, u),
+                None => self.point_on(prim, u),
+            };
+            let pdf = self.pdf(prim, *r, p, n);
+            *o = if pdf > 0.0 && pdf.is_finite() {
                 LightSample {
                     p,
                     n,
                     radiance: self.radiance,
-                    pdf: pdf_area * dist2 / cos_l,
+                    pdf,
                 }
             } else {
                 LightSample {
@@ -127,15 +174,14 @@ impl Light for AreaLight {
     }
 
     fn eval_hits(&self, hits: &[EmitterHit], out: &mut [EmitterEval]) {
-        let pdf_area = 1.0 / self.area;
+        let nprims = self.cdf.len();
         for (h, o) in hits.iter().zip(out.iter_mut()) {
-            let d = h.origin - h.p;
-            let dist2 = d.length_squared();
-            let cos_l = h.n.dot(d) / dist2.sqrt();
-            *o = if cos_l > 0.0 {
+            let prim = (h.primitive as usize).min(nprims - 1);
+            let pdf = self.pdf(prim, h.origin, h.p, h.n);
+            *o = if pdf > 0.0 {
                 EmitterEval {
                     radiance: self.radiance,
-                    pdf: pdf_area * dist2 / cos_l,
+                    pdf,
                 }
             } else {
                 EmitterEval::default()

@@ -1,5 +1,6 @@
 //! The `point` light: an isotropic point source.
 
+use crate::params::{check_colour, place};
 use radiant_core::glam::{DVec3, Vec2, Vec3};
 use radiant_core::{
     Color, Effects, Light, LightSample, ModuleInfo, ParamDoc, Params, Registry, Rgb, luminance,
@@ -18,7 +19,7 @@ const DOCS: &[ParamDoc] = &[
         name: "position",
         ty: "[x, y, z], world space",
         default: "required",
-        doc: "Where the light is.",
+        doc: "Where the light is (moved by the light's `transform`).",
     },
     ParamDoc {
         name: "intensity",
@@ -84,7 +85,8 @@ pub(crate) fn register(registry: &mut Registry) {
         },
         |params: &Params, ctx| {
             let p: PointParams = params.parse()?;
-            let position = ctx.to_render(DVec3::from_array(p.position));
+            check_colour(params, "intensity", p.intensity.0)?;
+            let position = place(ctx, DVec3::from_array(p.position));
             Ok(Box::new(PointLight::new(position, p.intensity.0)) as Box<dyn Light>)
         },
     );

@@ -94,7 +94,11 @@ impl ImageTexture {
 #[inline]
 fn texel_coordinate(c: f32) -> f32 {
     const LIMIT: f32 = (1u64 << 40) as f32;
-    if c.is_nan() { 0.0 } else { c.clamp(-LIMIT, LIMIT) }
+    if c.is_nan() {
+        0.0
+    } else {
+        c.clamp(-LIMIT, LIMIT)
+    }
 }
 
 impl Texture for ImageTexture {

@@ -4,7 +4,7 @@
 //! the parameter's line and column.
 
 use super::*;
-use radiant_core::glam::{DVec3, Mat4, UVec2, Vec2};
+use radiant_core::glam::Vec2;
 use radiant_core::params::check_param_docs;
 use radiant_core::registry::BuildError;
 use radiant_core::{BuildContext, Params, Rgb, Texture, TextureId, TextureTable};
@@ -43,17 +43,7 @@ impl Scene {
 
     /// Builds texture `ty` from `yaml` and names it `name`.
     fn add(&mut self, name: &str, ty: &str, yaml: &str) -> Result<TextureId, BuildError> {
-        let mut ctx = BuildContext {
-            resolution: UVec2::new(8, 8),
-            camera_to_render: Mat4::IDENTITY,
-            render_origin: DVec3::ZERO,
-            seed: 0,
-            spp: 1,
-            emitter_shape: None,
-            scene_dir: &self.dir,
-            textures: &mut self.textures,
-            named_textures: &self.named,
-        };
+        let mut ctx = BuildContext::standalone(&self.dir, &mut self.textures, &self.named);
         let params = Params::from_yaml(yaml).expect("test YAML parses");
         let texture = self.registry.build::<dyn Texture>(ty, &params, &mut ctx)?;
         let id = self.textures.add(texture);

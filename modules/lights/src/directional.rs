@@ -1,0 +1,137 @@
+//! The `directional` light: parallel light from infinitely far away, such
+//! as sunlight. Its next-event samples lie outside the scene's bounding
+//! sphere, against the direction of travel.
+
+use crate::params::{axis, check_colour};
+use radiant_core::glam::{DVec3, Vec2, Vec3};
+use radiant_core::{
+    BoundingSphere, Color, Effects, Light, LightSample, ModuleInfo, ParamDoc, Params, Registry,
+    Rgb, luminance,
+};
+use serde::Deserialize;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DirectionalParams {
+    direction: Option<[f64; 3]>,
+    irradiance: Color,
+}
+
+const DOCS: &[ParamDoc] = &[
+    ParamDoc {
+        name: "direction",
+        ty: "[x, y, z]",
+        default: "[0, 0, 1]",
+        doc: "Direction in which the light travels (turned by the light's `transform`).",
+    },
+    ParamDoc {
+        name: "irradiance",
+        ty: "rgb, W/m²",
+        default: "required",
+        doc: "Irradiance on a surface facing the light.",
+    },
+];
+
+/// Light arriving from the single direction `-direction` with the same
+/// irradiance everywhere.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DirectionalLight {
+    direction: Vec3,
+    irradiance: Rgb,
+    sphere: BoundingSphere,
+}
+
+impl DirectionalLight {
+    /// Light travelling along the unit vector `direction` (render space),
+    /// for a scene bounded by `sphere`.
+    pub fn new(direction: Vec3, irradiance: Rgb, sphere: BoundingSphere) -> Self {
+        Self {
+            direction,
+            irradiance,
+            sphere,
+        }
+    }
+}
+
+impl Light for DirectionalLight {
+    /// The power falling on a disc that covers the scene: π r² E.
+    fn power(&self) -> f32 {
+        std::f32::consts::PI * self.sphere.radius * self.sphere.radius * luminance(self.irradiance)
+    }
+
+    fn is_delta(&self) -> bool {
+        true
+    }
+
+    fn sample(&self, refs: &[Vec3], _u: &[Vec2], out: &mut [LightSample]) {
+        let back = self.direction * (-2.0 * self.sphere.radius);
+        for (r, o) in refs.iter().zip(out.iter_mut()) {
+            *o = LightSample {
+                p: *r + back,
+                n: Vec3::ZERO,
+                radiance: self.irradiance,
+                pdf: 1.0,
+            };
+        }
+    }
+
+    fn effects(&self) -> Effects {
+        Effects::DELTA_LIGHTS
+    }
+}
+
+pub(crate) fn register(registry: &mut Registry) {
+    registry.register::<dyn Light>(
+        ModuleInfo {
+            type_name: "directional",
+            summary: "Parallel light from infinitely far away (e.g. the sun).",
+            params: DOCS,
+        },
+        |params: &Params, ctx| {
+            let p: DirectionalParams = params.parse()?;
+            check_colour(params, "irradiance", p.irradiance.0)?;
+            let direction = axis(params, ctx, DVec3::ZERO, p.direction, None)?;
+            Ok(Box::new(DirectionalLight::new(
+                direction,
+                p.irradiance.0,
+                ctx.scene_sphere,
+            )) as Box<dyn Light>)
+        },
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use radiant_core::params::check_param_docs;
+
+    #[test]
+    fn documented_parameters_match() {
+        check_param_docs::<DirectionalParams>(DOCS).unwrap();
+    }
+
+    #[test]
+    fn samples_lie_upstream_outside_the_scene() {
+        let sphere = BoundingSphere {
+            centre: Vec3::new(1.0, 0.0, 0.0),
+            radius: 3.0,
+        };
+        let d = Vec3::new(0.0, -1.0, 0.0);
+        let light = DirectionalLight::new(d, Rgb::new(1.0, 2.0, 3.0), sphere);
+        let refs = [Vec3::new(1.0, 0.0, 0.0), Vec3::new(3.9, -1.0, 0.5)];
+        let mut out = [LightSample::default(); 2];
+        light.sample(&refs, &[Vec2::ZERO; 2], &mut out);
+        for (s, r) in out.iter().zip(&refs) {
+            // Straight up from the reference point, beyond the sphere.
+            let to = (s.p - *r).normalize();
+            assert!((to - (-d)).length() < 1e-6);
+            assert!((s.p - sphere.centre).length() > sphere.radius);
+            assert_eq!(
+                (s.radiance, s.pdf, s.n),
+                (Rgb::new(1.0, 2.0, 3.0), 1.0, Vec3::ZERO)
+            );
+        }
+        let expected = std::f32::consts::PI * 9.0 * luminance(Rgb::new(1.0, 2.0, 3.0));
+        assert!((light.power() - expected).abs() < 1e-4);
+    }
+}

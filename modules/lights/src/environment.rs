@@ -1,0 +1,353 @@
+//! The `environment` light: radiance arriving from infinitely far away in
+//! every direction, from an equirectangular map (EXR or Radiance HDR) or a
+//! constant colour.
+//!
+//! Conventions are Mitsuba 3's `envmap`, so references match: +y is up, a
+//! light-space direction d maps to u = atan2(d.x, −d.z) / 2π,
+//! v = acos(d.y) / π, pixel (x, y) sits at (u, v) = ((x + ½) / W, y / (H − 1))
+//! (the first row is the zenith, the last the nadir, the map wraps in u)
+//! and radiance is interpolated bilinearly between pixels (checked against
+//! Mitsuba's own `eval` in `tests/lights.rs`).
+//!
+//! Importance sampling: the W × (H − 1) cells between pixel centres get
+//! weights luminance × solid angle (the mean of their four corners' lumina
+//! times the cell's band of cos θ), sampled with a [`Distribution2D`];
+//! within a cell, φ and cos θ are uniform, so the density is constant over
+//! each cell's solid angle.
+
+use crate::map_file::load_map;
+use crate::params::check_colour;
+use radiant_core::distribution::Distribution2D;
+use radiant_core::glam::{DMat3, Mat3, UVec2, Vec2, Vec3};
+use radiant_core::warp::{UNIFORM_SPHERE_PDF, square_to_uniform_sphere};
+use radiant_core::{
+    BoundingSphere, Color, Effects, EmitterEval, Light, LightSample, ModuleInfo, ParamDoc,
+    ParamError, Params, Registry, Rgb, luminance,
+};
+use serde::Deserialize;
+use std::f32::consts::{PI, TAU};
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EnvironmentParams {
+    filename: Option<String>,
+    radiance: Option<Color>,
+    #[serde(default = "one")]
+    scale: f32,
+}
+
+fn one() -> f32 {
+    1.0
+}
+
+const DOCS: &[ParamDoc] = &[
+    ParamDoc {
+        name: "filename",
+        ty: "path to .exr or .hdr",
+        default: "none",
+        doc: "Equirectangular map of linear radiance (W/(m²·sr)), zenith (+y) in the first row; relative to the scene file. Give this or `radiance`.",
+    },
+    ParamDoc {
+        name: "radiance",
+        ty: "rgb, W/(m²·sr)",
+        default: "none",
+        doc: "Constant radiance from every direction, instead of a map.",
+    },
+    ParamDoc {
+        name: "scale",
+        ty: "number ≥ 0",
+        default: "1",
+        doc: "Factor on the radiance. The light's `transform` (a rotation) turns the map.",
+    },
+];
+
+/// A tabulated environment map with its sampling distribution.
+#[derive(Debug, Clone, PartialEq)]
+struct Map {
+    size: UVec2,
+    /// Radiance per pixel, row-major, scale applied.
+    texels: Vec<Rgb>,
+    /// cos θ of each pixel row.
+    cos_theta: Vec<f32>,
+    distribution: Distribution2D,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum Emission {
+    Constant(Rgb),
+    Map(Map),
+}
+
+/// Radiance from infinitely far away.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnvironmentLight {
+    emission: Emission,
+    /// Light space to render space (a rotation) and back.
+    to_render: Mat3,
+    to_light: Mat3,
+    sphere: BoundingSphere,
+    /// ∫ luminance dω over the sphere.
+    integral: f32,
+}
+
+impl EnvironmentLight {
+    /// A constant environment of `radiance`.
+    pub fn constant(radiance: Rgb, sphere: BoundingSphere) -> Self {
+        Self {
+            emission: Emission::Constant(radiance),
+            to_render: Mat3::IDENTITY,
+            to_light: Mat3::IDENTITY,
+            sphere,
+            integral: 4.0 * PI * luminance(radiance),
+        }
+    }
+
+    /// An environment map of `size.x × size.y` linear-radiance pixels
+    /// (row-major, zenith first), turned by the rotation `to_render`.
+    pub fn from_pixels(
+        pixels: Vec<Rgb>,
+        size: UVec2,
+        to_render: Mat3,
+        sphere: BoundingSphere,
+    ) -> Result<Self, String> {
+        let (w, h) = (size.x as usize, size.y as usize);
+        if w < 1 || h < 2 || pixels.len() != w * h {
+            return Err(format!(
+                "an environment map needs at least 1 × 2 pixels, found {} × {}",
+                size.x, size.y
+            ));
+        }
+        if let Some(i) = pixels
+            .iter()
+            .position(|p| !p.is_finite() || p.min_element() < 0.0)
+        {
+            return Err(format!(
+                "the environment map's pixel ({}, {}) is {}; radiance must be finite and non-negative",
+                i % w,
+                i / w,
+                pixels[i]
+            ));
+        }
+        let cos_theta: Vec<f32> = (0..h)
+            .map(|y| (PI * y as f32 / (h - 1) as f32).cos())
+            .collect();
+        let lum: Vec<f32> = pixels.iter().map(|p| luminance(*p)).collect();
+        let mut weights = Vec::with_capacity(w * (h - 1));
+        for y in 0..h - 1 {
+            let band = (cos_theta[y] - cos_theta[y + 1]).max(0.0);
+            for x in 0..w {
+                let x1 = (x + 1) % w;
+                let corners =
+                    lum[y * w + x] + lum[y * w + x1] + lum[(y + 1) * w + x] + lum[(y + 1) * w + x1];
+                weights.push(0.25 * corners * band);
+            }
+        }
+        let distribution = Distribution2D::new(&weights, UVec2::new(size.x, size.y - 1));
+        let integral = (TAU / w as f32) * distribution.total() as f32;
+        Ok(Self {
+            emission: Emission::Map(Map {
+                size,
+                texels: pixels,
+                cos_theta,
+                distribution,
+            }),
+            to_render,
+            to_light: to_render.transpose(),
+            sphere,
+            integral,
+        })
+    }
+
+    /// Radiance arriving from the light-space unit direction `d` and the
+    /// density with which `sample` picks it.
+    #[inline]
+    fn eval_local(&self, d: Vec3) -> EmitterEval {
+        match &self.emission {
+            Emission::Constant(c) => EmitterEval {
+                radiance: *c,
+                pdf: UNIFORM_SPHERE_PDF,
+            },
+            Emission::Map(m) => {
+                let mut u = d.x.atan2(-d.z) / TAU;
+                u -= u.floor();
+                let v = d.y.clamp(-1.0, 1.0).acos() / PI;
+                EmitterEval {
+                    radiance: m.lookup(u, v),
+                    pdf: m.pdf(u, v),
+                }
+            }
+        }
+    }
+}
+
+impl Map {
+    /// Bilinear interpolation between pixels, wrapping in u.
+    #[inline]
+    fn lookup(&self, u: f32, v: f32) -> Rgb {
+        let (w, h) = (self.size.x as usize, self.size.y as usize);
+        let fx = u * w as f32 - 0.5;
+        let fy = v * (h - 1) as f32;
+        let xf = fx.floor();
+        let x0 = (xf as isize).rem_euclid(w as isize) as usize;
+        let y0 = (fy as usize).min(h - 2);
+        let (tx, ty) = (fx - xf, fy - y0 as f32);
+        let x1 = (x0 + 1) % w;
+        let t = |x: usize, y: usize| self.texels[y * w + x];
+        let top = t(x0, y0) * (1.0 - tx) + t(x1, y0) * tx;
+        let bottom = t(x0, y0 + 1) * (1.0 - tx) + t(x1, y0 + 1) * tx;
+        top * (1.0 - ty) + bottom * ty
+    }
+
+    /// The cell holding (u, v); cell x lies between the centres of pixels
+    /// x and x + 1.
+    #[inline]
+    fn cell(&self, u: f32, v: f32) -> UVec2 {
+        let w = self.size.x as f32;
+        let x = ((u * w - 0.5).floor() as i64).rem_euclid(self.size.x as i64) as u32;
+        let y = ((v * (self.size.y - 1) as f32) as u32).min(self.size.y - 2);
+        UVec2::new(x, y)
+    }
+
+    /// Solid-angle density of the cell holding (u, v).
+    #[inline]
+    fn pdf(&self, u: f32, v: f32) -> f32 {
+        let c = self.cell(u, v);
+        self.cell_pdf(c)
+    }
+
+    #[inline]
+    fn cell_pdf(&self, c: UVec2) -> f32 {
+        let band = self.cos_theta[c.y as usize] - self.cos_theta[c.y as usize + 1];
+        let rows = (self.size.y - 1) as f32;
+        if band > 0.0 {
+            self.distribution.pdf(c) / (rows * TAU * band)
+        } else {
+            0.0
+        }
+    }
+
+    /// A light-space direction for the sample `u`, with its (u, v) and
+    /// density.
+    #[inline]
+    fn sample(&self, u: Vec2) -> (Vec3, f32, f32, f32) {
+        let (p, c) = self.distribution.sample(u);
+        let rows = (self.size.y - 1) as f32;
+        let fv = (p.y * rows - c.y as f32).clamp(0.0, 1.0);
+        let (z0, z1) = (
+            self.cos_theta[c.y as usize],
+            self.cos_theta[c.y as usize + 1],
+        );
+        let cos_t = (z0 + (z1 - z0) * fv).clamp(-1.0, 1.0);
+        let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+        // Cells start at the first pixel centre, half a pixel into the map.
+        let mut u = p.x + 0.5 / self.size.x as f32;
+        if u >= 1.0 {
+            u -= 1.0;
+        }
+        let (sin_p, cos_p) = (TAU * u).sin_cos();
+        let d = Vec3::new(sin_p * sin_t, cos_t, -cos_p * sin_t);
+        (d, u, cos_t.acos() / PI, self.cell_pdf(c))
+    }
+}
+
+impl Light for EnvironmentLight {
+    /// π r² ∫ L dω: the power through a disc covering the scene.
+    fn power(&self) -> f32 {
+        PI * self.sphere.radius * self.sphere.radius * self.integral
+    }
+
+    fn is_delta(&self) -> bool {
+        false
+    }
+
+    fn sample(&self, refs: &[Vec3], u: &[Vec2], out: &mut [LightSample]) {
+        let reach = 2.0 * self.sphere.radius;
+        for ((r, u), o) in refs.iter().zip(u).zip(out.iter_mut()) {
+            let (local, radiance, pdf) = match &self.emission {
+                Emission::Constant(c) => (square_to_uniform_sphere(*u), *c, UNIFORM_SPHERE_PDF),
+                Emission::Map(m) => {
+                    let (d, su, sv, pdf) = m.sample(*u);
+                    (d, m.lookup(su, sv), pdf)
+                }
+            };
+            let wi = self.to_render * local;
+            *o = LightSample {
+                p: *r + wi * reach,
+                n: Vec3::ZERO,
+                radiance: if pdf > 0.0 { radiance } else { Rgb::ZERO },
+                pdf,
+            };
+        }
+    }
+
+    fn eval_escaped(&self, dirs: &[Vec3], out: &mut [EmitterEval]) {
+        for (d, o) in dirs.iter().zip(out.iter_mut()) {
+            *o = self.eval_local(self.to_light * *d);
+        }
+    }
+
+    fn effects(&self) -> Effects {
+        Effects::ENVIRONMENT
+    }
+}
+
+/// The rotation part of a light transform, or an error if it is not one.
+fn rotation(m: DMat3) -> Result<Mat3, ParamError> {
+    let orthonormal = (m.transpose() * m - DMat3::IDENTITY)
+        .to_cols_array()
+        .iter()
+        .all(|e| e.abs() < 1e-6);
+    if orthonormal && m.determinant() > 0.0 {
+        Ok(m.as_mat3())
+    } else {
+        Err(ParamError::new(
+            "an `environment` light's `transform` must be a rotation (no scale, shear, mirror or translation matters)",
+        ))
+    }
+}
+
+pub(crate) fn register(registry: &mut Registry) {
+    registry.register::<dyn Light>(
+        ModuleInfo {
+            type_name: "environment",
+            summary: "Light from infinitely far away: an equirectangular map (importance-sampled) or a constant.",
+            params: DOCS,
+        },
+        |params: &Params, ctx| {
+            let p: EnvironmentParams = params.parse()?;
+            if !(p.scale >= 0.0 && p.scale.is_finite()) {
+                return Err(ParamError {
+                    message: format!("`scale` must be finite and non-negative, found {}", p.scale),
+                    location: params.location_of("scale"),
+                });
+            }
+            let to_render = rotation(DMat3::from_mat4(ctx.to_world))?;
+            let light = match (p.filename, p.radiance) {
+                (Some(_), Some(_)) | (None, None) => {
+                    return Err(ParamError {
+                        message: "give the environment either a `filename` (an .exr or .hdr map) or a constant `radiance`".into(),
+                        location: params.location_of("radiance"),
+                    });
+                }
+                (None, Some(c)) => {
+                    check_colour(params, "radiance", c.0)?;
+                    EnvironmentLight::constant(c.0 * p.scale, ctx.scene_sphere)
+                }
+                (Some(f), None) => {
+                    let at = |message: String| ParamError {
+                        message,
+                        location: params.location_of("filename"),
+                    };
+                    let (mut pixels, size) = load_map(&ctx.scene_dir.join(&f)).map_err(at)?;
+                    for px in &mut pixels {
+                        *px *= p.scale;
+                    }
+                    EnvironmentLight::from_pixels(pixels, size, to_render, ctx.scene_sphere)
+                        .map_err(|m| at(format!("{f}: {m}")))?
+                }
+            };
+            Ok(Box::new(EnvironmentLight { to_render, to_light: to_render.transpose(), ..light })
+                as Box<dyn Light>)
+        },
+    );
+}
