@@ -41,11 +41,10 @@ fn fields_of_view_near_0_and_180_degrees_render_finite_images() {
         let v = (p.x + p.y + p.z) as f64 / 3.0;
         assert!((v / mean - 1.0).abs() < 0.5, "pixel {v} vs mean {mean}");
     }
-    // At 179.9° the box is a small patch in the middle of a black frame.
-    let corner = wide.pixels[0];
-    let centre = wide.pixels[(8 * wide.width + 8) as usize];
-    assert_eq!(corner, radiant_core::Rgb::ZERO);
-    assert!(centre.element_sum() > 0.0);
+    // At 179.9° the box covers about 1e-8 of the image (the rest looks out
+    // of its open front into nothing): black but for a rare sample.
+    assert_eq!((wide.width, wide.height), (16, 16));
+    assert!(wide.mean() < 1e-3 * mean, "{}", wide.mean());
 }
 
 #[test]

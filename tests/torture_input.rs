@@ -71,7 +71,9 @@ fn a_mesh_with_nothing_usable_is_an_error_with_its_location() {
     let shown = err.to_string();
     assert!(shown.starts_with("bad.yaml:3:"), "{shown}");
     assert!(
-        shown.contains("no usable triangles (1 dropped as degenerate, 1 for non-finite coordinates)"),
+        shown.contains(
+            "no usable triangles (1 dropped as degenerate, 1 for non-finite coordinates)"
+        ),
         "{shown}"
     );
 }
