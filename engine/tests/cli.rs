@@ -216,3 +216,35 @@ fn compare_prints_metrics_and_rejects_size_mismatches() {
     assert!(!o.status.success());
     assert!(stderr(&o).contains("differ in size"), "{}", stderr(&o));
 }
+
+#[test]
+fn mesh_repairs_are_warned_about_and_listed_by_info() {
+    let (_dir, out) = temp("degenerate.exr");
+    let scene = "scenes/hard/degenerate-mesh.yaml";
+    let o = radiant(&[
+        "render",
+        scene,
+        "-o",
+        out.to_str().unwrap(),
+        "--spp",
+        "1",
+        "--threads",
+        "1",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let warning = "bad mesh (scenes/hard/meshes/degenerate.obj): dropped 2 triangles with \
+                   non-finite coordinates and 3 triangles of zero area, replaced 1 vertex normal";
+    assert!(
+        stderr(&o).contains(&format!("warning: {warning}")),
+        "{}",
+        stderr(&o)
+    );
+    let o = radiant(&["info", scene]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(
+        text.contains("repairs      2 non-finite and 4 degenerate triangles dropped, 1 vertex normals replaced, 1 texture coordinates reset"),
+        "{text}"
+    );
+    assert!(text.contains(warning), "{text}");
+}

@@ -19,6 +19,30 @@ pub fn render_scene(scene: &str, overrides: Overrides) -> Image {
     render(&r, &Progress::none()).image
 }
 
+/// Renders like [`render_scene`] and checks what every torture case must
+/// satisfy: no sample was NaN or infinite (the film would have recorded it
+/// as black), every pixel is finite, and the image has the requested size.
+pub fn render_checked(scene: &str, overrides: Overrides) -> Image {
+    let loaded = radiant::scene::load(root().join(scene)).expect("scene loads");
+    let r = extract(&loaded, &radiant::builtin_registry(), &overrides).expect("scene extracts");
+    let rendered = render(&r, &Progress::none());
+    assert_eq!(
+        rendered.invalid_samples, 0,
+        "{scene}: samples were NaN or infinite"
+    );
+    let image = rendered.image;
+    assert_eq!(
+        (image.width, image.height),
+        (r.settings.width, r.settings.height),
+        "{scene}: wrong image size"
+    );
+    assert!(
+        image.pixels.iter().all(|p| p.is_finite()),
+        "{scene}: non-finite pixels"
+    );
+    image
+}
+
 /// Mean of each colour channel.
 pub fn channel_means(image: &Image) -> [f64; 3] {
     let mut m = [0.0f64; 3];

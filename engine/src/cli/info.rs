@@ -32,10 +32,17 @@ pub fn run(registry: &Registry, path: &Path) -> miette::Result<()> {
     let modules: Vec<String> = r.modules.iter().map(|(k, t)| format!("{k} {t}")).collect();
     println!("modules      {}", modules.join(", "));
     println!("effects      {}", r.effects.names().join(", "));
+    let repairs = &r.stats.repairs;
     println!(
-        "repairs      {} non-finite and {} degenerate triangles dropped, {} vertex normals replaced",
-        r.stats.dropped_non_finite, r.stats.dropped_degenerate, r.stats.repaired_normals
+        "repairs      {} non-finite and {} degenerate triangles dropped, {} vertex normals replaced, {} texture coordinates reset",
+        repairs.non_finite, repairs.degenerate, repairs.bad_normals, repairs.bad_uvs
     );
+    for (shape, what) in &r.stats.repaired_shapes {
+        println!("             {shape}: {}", what.describe());
+    }
+    if repairs.missing_uvs {
+        println!("uvs          missing in some meshes: (0,0), (1,0), (0,1) per triangle");
+    }
     println!(
         "bvh build    {:.3} ms",
         r.stats.bvh_build.as_secs_f64() * 1e3

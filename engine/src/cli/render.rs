@@ -84,6 +84,9 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         height: args.height,
     };
     let render_scene = extract(&scene, registry, &overrides).map_err(report)?;
+    for (shape, what) in &render_scene.stats.repaired_shapes {
+        eprintln!("warning: {shape}: {}", what.describe());
+    }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0))
         .build()

@@ -16,7 +16,8 @@ pub use lights::LightTable;
 use crate::accel::{Accel, BuildQuality, Primitive};
 use crate::scene::{RenderSettings, Scene, SceneError, module_error};
 use crate::world::{
-    CameraPose, EmitterSpec, Geometry, LightSpec, MaterialRef, ModuleSpec, Transform,
+    CameraPose, EmitterSpec, FlippedNormals, Geometry, LightSpec, MaterialRef, MeshRepairs,
+    ModuleSpec, Name, Transform,
 };
 use glam::{DMat4, UVec2, Vec2, Vec3};
 use materials::NestedMaterials;
@@ -71,12 +72,12 @@ pub struct SceneStats {
     pub spheres: usize,
     /// Shapes carrying an emitter.
     pub emissive_shapes: usize,
-    /// Triangles dropped on load for non-finite coordinates.
-    pub dropped_non_finite: usize,
-    /// Triangles dropped on load for zero area.
-    pub dropped_degenerate: usize,
-    /// Vertex normals replaced by face normals.
-    pub repaired_normals: usize,
+    /// What was repaired in all shapes together (on load and in render
+    /// space).
+    pub repairs: MeshRepairs,
+    /// Each shape in which something was repaired, by name (and mesh
+    /// file), with its counts (a mesh used by several shapes is listed for each).
+    pub repaired_shapes: Vec<(String, MeshRepairs)>,
     /// BVH build time.
     pub bvh_build: Duration,
 }
@@ -209,17 +210,27 @@ pub fn extract(
     let mut emitter_prim = Vec::new();
     let mut lights: Vec<Box<dyn Light>> = Vec::new();
     let mut stats = SceneStats::default();
-    let mut query = scene
-        .world
-        .query::<(&Transform, &Geometry, &MaterialRef, Option<&EmitterSpec>)>();
-    for (transform, geometry, mat, emitter_spec) in query.iter() {
+    let mut query = scene.world.query::<(
+        &Name,
+        &Transform,
+        &Geometry,
+        &MaterialRef,
+        Option<&EmitterSpec>,
+        Option<&FlippedNormals>,
+    )>();
+    for (name, transform, geometry, mat, emitter_spec, flipped) in query.iter() {
         let start = prims.len();
-        tessellate(geometry, transform.0, render_origin, &mut prims);
+        let flip = flipped.is_some();
+        let mut repairs = tessellate(geometry, transform.0, render_origin, flip, &mut prims);
         let count = prims.len() - start;
+        let mut label = name.0.clone();
         if let Geometry::Mesh(mesh) = geometry {
-            stats.dropped_non_finite += mesh.repairs.non_finite;
-            stats.dropped_degenerate += mesh.repairs.degenerate;
-            stats.repaired_normals += mesh.repairs.bad_normals;
+            repairs.add(&mesh.repairs);
+            label = format!("{label} ({})", mesh.source);
+        }
+        stats.repairs.add(&repairs);
+        if repairs.any() {
+            stats.repaired_shapes.push((label, repairs));
         }
         let light_id = match emitter_spec {
             Some(EmitterSpec(spec)) => {

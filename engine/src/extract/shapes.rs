@@ -1,6 +1,11 @@
 //! Tessellation of the scene's shapes into render-space primitives.
+//!
+//! The last line of defence against degenerate geometry: a triangle whose
+//! render-space (single-precision) coordinates or normal are not finite,
+//! or whose normal vanishes in single precision, is dropped and counted, so the
+//! integrator never meets a NaN normal.
 
-use crate::world::Geometry;
+use crate::world::{Geometry, MeshRepairs};
 use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};
 
 /// One primitive with its shading attributes, in render space.
@@ -28,29 +33,44 @@ const CUBE_FACES: [(DVec3, DVec3, DVec3); 6] = [
 ];
 
 /// Tessellates `geometry` under `to_world`, then shifts it so that
-/// `render_origin` becomes the origin, appending to `out`.
+/// `render_origin` becomes the origin, appending to `out`. With `flip`, the
+/// front side of every triangle (its winding and shading normals) is turned
+/// round. Returns the triangles dropped as unusable in render space.
 pub(crate) fn tessellate(
     geometry: &Geometry,
     to_world: DMat4,
     render_origin: DVec3,
+    flip: bool,
     out: &mut Vec<ShapePrim>,
-) {
+) -> MeshRepairs {
     let point = |p: DVec3| (to_world.transform_point3(p) - render_origin).as_vec3();
     let normal_matrix = DMat3::from_mat4(to_world).inverse().transpose();
     let normal = |n: DVec3| (normal_matrix * n).normalize_or_zero().as_vec3();
     // A mirroring transform reverses the winding; swap two vertices so the
-    // face normal stays the transformed normal.
-    let mirrored = to_world.determinant() < 0.0;
+    // face normal stays the transformed normal. Flipping swaps them (back).
+    let swap = (to_world.determinant() < 0.0) != flip;
+    let sign = if flip { -1.0 } else { 1.0 };
+    let mut dropped = MeshRepairs::default();
     let mut push = |v: [Vec3; 3], n: [Vec3; 3], uv: [Vec2; 3]| {
-        if mirrored {
-            out.push(ShapePrim::Triangle {
+        let normal = (v[1] - v[0]).cross(v[2] - v[0]);
+        if !(v.iter().all(|p| p.is_finite()) && normal.is_finite()) {
+            dropped.non_finite += 1;
+            return;
+        }
+        if normal.try_normalize().is_none() {
+            dropped.degenerate += 1;
+            return;
+        }
+        let n = n.map(|n| n * sign);
+        out.push(if swap {
+            ShapePrim::Triangle {
                 v: [v[0], v[2], v[1]],
                 n: [n[0], n[2], n[1]],
                 uv: [uv[0], uv[2], uv[1]],
-            });
+            }
         } else {
-            out.push(ShapePrim::Triangle { v, n, uv });
-        }
+            ShapePrim::Triangle { v, n, uv }
+        });
     };
     let quad = |push: &mut dyn FnMut([Vec3; 3], [Vec3; 3], [Vec2; 3]), c: [DVec3; 4]| {
         let p = c.map(point);
@@ -75,6 +95,7 @@ pub(crate) fn tessellate(
             }
         }
         Geometry::Sphere => {
+            debug_assert!(!flip, "the scene loader rejects flipped spheres");
             let centre = point(DVec3::ZERO);
             let radius = to_world.transform_vector3(DVec3::X).length() as f32;
             out.push(ShapePrim::Sphere { centre, radius });
@@ -97,6 +118,7 @@ pub(crate) fn tessellate(
             }
         }
     }
+    dropped
 }
 
 #[cfg(test)]
@@ -113,7 +135,13 @@ mod tests {
     #[test]
     fn cube_faces_point_outwards() {
         let mut prims = Vec::new();
-        tessellate(&Geometry::Cube, DMat4::IDENTITY, DVec3::ZERO, &mut prims);
+        tessellate(
+            &Geometry::Cube,
+            DMat4::IDENTITY,
+            DVec3::ZERO,
+            false,
+            &mut prims,
+        );
         assert_eq!(prims.len(), 12);
         for p in &prims {
             let ShapePrim::Triangle { v, .. } = p else {
@@ -131,11 +159,69 @@ mod tests {
             DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
         ] {
             let mut prims = Vec::new();
-            tessellate(&Geometry::Rectangle, m, DVec3::ZERO, &mut prims);
+            tessellate(&Geometry::Rectangle, m, DVec3::ZERO, false, &mut prims);
             for p in &prims {
                 assert!((face_normal(p) - Vec3::Z).length() < 1e-6);
             }
         }
+    }
+
+    #[test]
+    fn flipped_cube_faces_point_inwards_and_mirroring_composes() {
+        for m in [
+            DMat4::IDENTITY,
+            DMat4::from_scale(DVec3::new(1.0, -1.0, 1.0)),
+        ] {
+            let mut prims = Vec::new();
+            let dropped = tessellate(&Geometry::Cube, m, DVec3::ZERO, true, &mut prims);
+            assert_eq!((prims.len(), dropped), (12, MeshRepairs::default()));
+            for p in &prims {
+                let ShapePrim::Triangle { v, .. } = p else {
+                    unreachable!()
+                };
+                let centre = (v[0] + v[1] + v[2]) / 3.0;
+                assert!(face_normal(p).dot(centre) < 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn triangles_unusable_in_render_space_are_dropped_and_counted() {
+        let mesh = crate::world::MeshData {
+            positions: vec![
+                Vec3::ZERO,
+                Vec3::X,
+                Vec3::Y,
+                // A needle whose height vanishes once scaled by 1e-30.
+                Vec3::new(2.0, 0.0, 0.0),
+                Vec3::new(3.0, 1e-7, 0.0),
+                Vec3::new(4.0, 0.0, 0.0),
+            ],
+            triangles: vec![[0, 1, 2], [3, 4, 5]],
+            ..Default::default()
+        };
+        let geometry = Geometry::Mesh(std::sync::Arc::new(mesh));
+        let mut prims = Vec::new();
+        let dropped = tessellate(
+            &geometry,
+            DMat4::from_scale(DVec3::splat(1e-30)),
+            DVec3::ZERO,
+            false,
+            &mut prims,
+        );
+        assert_eq!((prims.len(), dropped.degenerate), (0, 2), "{dropped:?}");
+        prims.clear();
+        let dropped = tessellate(
+            &geometry,
+            DMat4::from_scale(DVec3::splat(1e38)),
+            DVec3::ZERO,
+            false,
+            &mut prims,
+        );
+        assert_eq!((prims.len(), dropped.non_finite), (0, 2), "{dropped:?}");
+        prims.clear();
+        let dropped = tessellate(&geometry, DMat4::IDENTITY, DVec3::ZERO, false, &mut prims);
+        assert_eq!((prims.len(), dropped), (2, MeshRepairs::default()));
     }
 
     #[test]
@@ -146,6 +232,7 @@ mod tests {
             &Geometry::Rectangle,
             DMat4::from_translation(far) * DMat4::from_scale(DVec3::splat(1e-3)),
             far,
+            false,
             &mut prims,
         );
         let ShapePrim::Triangle { v, .. } = prims[0] else {

@@ -31,7 +31,8 @@ mod yaml;
 pub use error::SceneError;
 
 use crate::world::{
-    CameraPose, EmitterSpec, Geometry, LightSpec, MaterialRef, ModuleSpec, Name, Transform,
+    CameraPose, EmitterSpec, FlippedNormals, Geometry, LightSpec, MaterialRef, ModuleSpec, Name,
+    Transform,
 };
 use glam::{DMat4, DVec3};
 use hecs::World;
@@ -142,6 +143,11 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
                 shape.geometry,
                 shape.material,
             ));
+            if shape.flip_normals {
+                world
+                    .insert_one(entity, FlippedNormals)
+                    .expect("entity was just spawned");
+            }
             if let Some(emitter) = shape.emitter {
                 world
                     .insert_one(entity, EmitterSpec(emitter))
@@ -397,6 +403,7 @@ struct ShapeDef {
     geometry: Geometry,
     material: MaterialRef,
     emitter: Option<ModuleSpec>,
+    flip_normals: bool,
 }
 
 #[derive(Deserialize)]
@@ -443,6 +450,20 @@ fn parse_shape(
         .map(|e| module_spec(file, e, "emitter", &[]))
         .transpose()?;
     let material = parse_material_ref(file, map.get("material"), &name, materials, material_ids)?;
+    let flip_node = map.get("flip_normals");
+    let flip_normals = match flip_node {
+        Some(node) => match node.as_scalar().and_then(|s| s.as_bool()) {
+            Some(b) => b,
+            None => {
+                return Err(SceneError::new(
+                    file,
+                    loc(node.span()),
+                    "`flip_normals` must be true or false",
+                ));
+            }
+        },
+        None => false,
+    };
 
     let (geometry, allowed): (Geometry, &[&str]) = match type_name.as_str() {
         "rectangle" => (Geometry::Rectangle, &[]),
@@ -500,9 +521,23 @@ fn parse_shape(
             ));
         }
     };
-    let mut keys = vec!["type", "name", "transform", "emitter", "material"];
+    let mut keys = vec![
+        "type",
+        "name",
+        "transform",
+        "emitter",
+        "material",
+        "flip_normals",
+    ];
     keys.extend_from_slice(allowed);
     map.finish(&keys)?;
+    if let (Geometry::Sphere, true, Some(node)) = (&geometry, flip_normals, flip_node) {
+        return Err(SceneError::new(
+            file,
+            loc(node.span()),
+            "`flip_normals` is not supported on spheres; use a cube or a mesh for an inward-facing enclosure",
+        ));
+    }
     if matches!(geometry, Geometry::Sphere) && !is_similarity(transform) {
         return Err(SceneError::new(
             file,
@@ -516,6 +551,7 @@ fn parse_shape(
         geometry,
         material,
         emitter,
+        flip_normals,
     })
 }
 

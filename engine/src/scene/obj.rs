@@ -1,9 +1,13 @@
 //! Wavefront OBJ meshes (through tobj), repaired on load.
 //!
 //! Degenerate input is repaired, never passed on: triangles with
-//! non-finite coordinates or zero area are dropped, and vertex normals that
-//! are zero or non-finite are marked so the face normal is used instead.
-//! [`MeshRepairs`] counts what was done; `radiant info` reports it.
+//! non-finite coordinates or zero area (repeated or collinear vertices)
+//! are dropped, vertex normals that are zero or non-finite are marked so
+//! the face normal is used instead, and non-finite texture coordinates
+//! become (0, 0). Needle triangles (positive but tiny area) are kept: the
+//! watertight intersection test handles them; extract drops those whose
+//! normal vanishes in single precision. [`MeshRepairs`] counts what was
+//! done; `radiant render` warns about it and `radiant info` reports it.
 
 use crate::world::{MeshData, MeshRepairs};
 use glam::{DVec3, Vec2, Vec3};
@@ -21,7 +25,10 @@ pub fn load_obj(path: &Path) -> Result<MeshData, String> {
         tobj::LoadError::OpenFileFailed => format!("cannot open mesh file `{}`", path.display()),
         other => format!("cannot read mesh file `{}`: {other}", path.display()),
     })?;
-    let mut mesh = MeshData::default();
+    let mut mesh = MeshData {
+        source: path.display().to_string(),
+        ..MeshData::default()
+    };
     let mut normals = Vec::new();
     let mut uvs = Vec::new();
     let all_have_normals = models.iter().all(|m| !m.mesh.normals.is_empty());
@@ -107,10 +114,14 @@ pub fn repair(mesh: &mut MeshData) {
             }
         }
     }
-    if let Some(uvs) = &mut mesh.uvs {
-        for uv in uvs.iter_mut().filter(|uv| !uv.is_finite()) {
-            *uv = Vec2::ZERO;
+    match &mut mesh.uvs {
+        Some(uvs) => {
+            for uv in uvs.iter_mut().filter(|uv| !uv.is_finite()) {
+                *uv = Vec2::ZERO;
+                repairs.bad_uvs += 1;
+            }
         }
+        None => repairs.missing_uvs = true,
     }
     mesh.repairs = repairs;
 }
@@ -138,6 +149,7 @@ mod tests {
             "collinear and repeated-vertex faces"
         );
         assert_eq!(mesh.repairs.bad_normals, 1);
+        assert!(mesh.repairs.missing_uvs);
     }
 
     #[test]

@@ -37,15 +37,85 @@ pub enum Geometry {
     Mesh(Arc<MeshData>),
 }
 
-/// What the mesh loader repaired, for reporting.
+/// What loading and tessellation repaired in a shape, for reporting.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct MeshRepairs {
-    /// Triangles dropped for non-finite vertex coordinates.
+    /// Triangles dropped for non-finite vertex coordinates (in the file, or
+    /// after the transform to render space overflowed).
     pub non_finite: usize,
-    /// Triangles dropped for zero area (including repeated vertices).
+    /// Triangles dropped for zero area (repeated vertices, collinear
+    /// vertices, or a normal that is zero in single precision once in
+    /// render space).
     pub degenerate: usize,
     /// Vertex normals that were zero or non-finite (the face normal is used).
     pub bad_normals: usize,
+    /// Texture coordinates that were non-finite (set to (0, 0)).
+    pub bad_uvs: usize,
+    /// The mesh has no texture coordinates: each triangle gets (0, 0),
+    /// (1, 0), (0, 1), as Mitsuba does.
+    pub missing_uvs: bool,
+}
+
+impl MeshRepairs {
+    /// Adds the counts of `other` to these.
+    pub fn add(&mut self, other: &MeshRepairs) {
+        self.non_finite += other.non_finite;
+        self.degenerate += other.degenerate;
+        self.bad_normals += other.bad_normals;
+        self.bad_uvs += other.bad_uvs;
+        self.missing_uvs |= other.missing_uvs;
+    }
+
+    /// Whether anything was dropped or replaced (missing texture
+    /// coordinates are normal and do not count).
+    pub fn any(&self) -> bool {
+        self.non_finite + self.degenerate + self.bad_normals + self.bad_uvs > 0
+    }
+
+    /// One line saying what was repaired, e.g. "dropped 2 triangles with
+    /// non-finite coordinates and 3 of zero area, replaced 1 vertex normal".
+    pub fn describe(&self) -> String {
+        let plural =
+            |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
+        let mut dropped = Vec::new();
+        if self.non_finite > 0 {
+            dropped.push(format!(
+                "{} with non-finite coordinates",
+                plural(self.non_finite, "triangle", "triangles")
+            ));
+        }
+        if self.degenerate > 0 {
+            dropped.push(format!(
+                "{} of zero area",
+                plural(self.degenerate, "triangle", "triangles")
+            ));
+        }
+        let mut parts = Vec::new();
+        if !dropped.is_empty() {
+            parts.push(format!("dropped {}", dropped.join(" and ")));
+        }
+        if self.bad_normals > 0 {
+            parts.push(format!(
+                "replaced {} of zero length or non-finite by the face normal",
+                plural(self.bad_normals, "vertex normal", "vertex normals")
+            ));
+        }
+        if self.bad_uvs > 0 {
+            parts.push(format!(
+                "set {} to (0, 0)",
+                plural(
+                    self.bad_uvs,
+                    "non-finite texture coordinate",
+                    "non-finite texture coordinates"
+                )
+            ));
+        }
+        if parts.is_empty() {
+            "nothing repaired".to_string()
+        } else {
+            parts.join(", ")
+        }
+    }
 }
 
 /// A triangle mesh in object space.
@@ -61,7 +131,14 @@ pub struct MeshData {
     pub triangles: Vec<[u32; 3]>,
     /// What loading repaired.
     pub repairs: MeshRepairs,
+    /// The file the mesh was read from, for messages.
+    pub source: String,
 }
+
+/// Marks a shape whose normals are flipped (`flip_normals: true`): its
+/// front side, the side that reflects and emits, faces the other way.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FlippedNormals;
 
 /// Index of a surface's material in the scene's material list.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -8,6 +8,6 @@
 mod components;
 
 pub use components::{
-    CameraPose, EmitterSpec, Geometry, LightSpec, MaterialRef, MeshData, MeshRepairs, ModuleSpec,
-    Name, Transform,
+    CameraPose, EmitterSpec, FlippedNormals, Geometry, LightSpec, MaterialRef, MeshData,
+    MeshRepairs, ModuleSpec, Name, Transform,
 };
