@@ -199,3 +199,12 @@ fn a_scene_without_camera_is_an_error() {
     let err = load("shapes: []\n").unwrap_err();
     assert!(err.to_string().contains("needs a `camera`"), "{err}");
 }
+
+#[test]
+fn unknown_light_selection_lists_the_allowed_ones() {
+    fails_at(
+        &format!("{CAMERA}integrator:\n  type: path\n  light_selection: powr\n"),
+        4,
+        &["powr", "power", "uniform"],
+    );
+}

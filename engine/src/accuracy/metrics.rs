@@ -12,6 +12,13 @@ use crate::compare::compare;
 use crate::film::Image;
 use crate::film::output::srgb_encode;
 
+/// Smallest block edge of the bias test: enough pixels per block for its
+/// variance estimate to be steady.
+const MIN_BLOCK: u32 = 8;
+
+/// Median of the χ² distribution with one degree of freedom.
+const CHI2_1_MEDIAN: f64 = 0.454_936_4;
+
 /// How far an image is from the reference.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Metrics {
@@ -133,12 +140,12 @@ pub struct BiasSplit {
 /// its halves if it was rendered here, or `None` for an outside reference
 /// assumed noise-free) into variance and bias.
 ///
-/// The bias test compares, over blocks of about 1/16 of the image's
-/// smaller side, the mean difference of each block with the spread of
+/// The bias test compares, over blocks of 1/16 of the image's smaller side
+/// (at least 8 pixels), the mean difference of each block with the spread of
 /// that difference expected from the halves: the variance of a block mean
 /// is estimated from the per-pixel variances scaled by one factor for the
-/// whole image (pixel filters correlate neighbours), fitted from the
-/// block means of the half differences.
+/// whole image (pixel filters correlate neighbours), the median over blocks
+/// of the squared block-mean half difference over that estimate.
 pub fn bias_split(
     image: Halves<'_>,
     reference: &Image,
@@ -156,7 +163,7 @@ pub fn bias_split(
     let variance = image.variance();
     let ref_variance = ref_halves.map_or(0.0, |h| h.variance());
     let (w, h) = (combined.width, combined.height);
-    let block = (w.min(h) / 16).max(2);
+    let block = (w.min(h) / 16).max(MIN_BLOCK);
     let (bw, bh) = (w.div_ceil(block), h.div_ceil(block));
     let nb = (bw * bh) as usize;
     // Per block: Σ (I − R), Σ half differences, Σ per-pixel variances, count.
@@ -177,17 +184,25 @@ pub fn bias_split(
             count[b] += 1;
         }
     }
-    let mut num = 0.0;
-    let mut den = 0.0;
+    let mut ratios = Vec::with_capacity(nb);
     for b in 0..nb {
         let c = count[b] as f64;
         d[b] /= c;
         half[b] /= c;
         pixel_var[b] /= c * c;
-        num += half[b] * half[b];
-        den += pixel_var[b];
+        if pixel_var[b] > 0.0 {
+            ratios.push(half[b] * half[b] / pixel_var[b]);
+        }
     }
-    let correlation = if den > 0.0 { (num / den).max(1.0) } else { 1.0 };
+    // Each ratio is about correlation × χ²₁, whose median is 0.4549: the
+    // median makes the factor robust to a few blocks of extreme noise.
+    let correlation = if ratios.is_empty() {
+        1.0
+    } else {
+        let mid = ratios.len() / 2;
+        let (_, median, _) = ratios.select_nth_unstable_by(mid, f64::total_cmp);
+        (*median / CHI2_1_MEDIAN).max(1.0)
+    };
     let (mut z2, mut used) = (0.0, 0usize);
     for b in 0..nb {
         let v = correlation * pixel_var[b];

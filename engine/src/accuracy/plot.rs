@@ -11,7 +11,7 @@ use std::path::Path;
 static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans-subset.ttf");
 
 /// Curve colours, cycled.
-const COLOURS: [RGBColor; 10] = [
+const COLOURS: [RGBColor; 14] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
@@ -22,6 +22,10 @@ const COLOURS: [RGBColor; 10] = [
     RGBColor(127, 127, 127),
     RGBColor(188, 189, 34),
     RGBColor(23, 190, 207),
+    RGBColor(0, 0, 128),
+    RGBColor(128, 128, 0),
+    RGBColor(0, 128, 128),
+    RGBColor(128, 0, 0),
 ];
 
 /// Plot size in pixels.
@@ -79,7 +83,9 @@ pub fn draw(report: &Report, path: &Path) -> Result<(), String> {
         .configure_mesh()
         .x_desc("time (s): extract + render, log scale")
         .y_desc("RMSE against the reference, log scale")
-        .x_label_formatter(&|v| format!("{v:.3}"))
+        .x_labels(6)
+        .y_labels(6)
+        .x_label_formatter(&|v| format!("{v:.2e}"))
         .y_label_formatter(&|v| format!("{v:.1e}"))
         .label_style(("sans-serif", 14))
         .draw()
@@ -101,7 +107,8 @@ pub fn draw(report: &Report, path: &Path) -> Result<(), String> {
 
     for (i, c) in curves.iter().enumerate() {
         let colour = COLOURS[i % COLOURS.len()];
-        let style = colour.stroke_width(2);
+        // The scene as written, drawn first, stands out.
+        let style = colour.stroke_width(if i == 0 { 4 } else { 2 });
         let data: Vec<(f64, f64)> = c.points.iter().map(|p| (p.time, p.metrics.rmse)).collect();
         let biased = c.is_biased();
         let label = if biased {

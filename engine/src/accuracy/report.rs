@@ -10,7 +10,7 @@ use std::fmt::Write;
 /// block means differ from the reference by more than this many times
 /// their expected noise variance (about 1 without bias; see
 /// [`BiasSplit::block_z2`](super::metrics::BiasSplit::block_z2)).
-pub const BIAS_Z2_THRESHOLD: f64 = 2.0;
+pub const BIAS_Z2_THRESHOLD: f64 = 3.0;
 
 /// Least-squares slope of ln y against ln x (`None` with fewer than two
 /// distinct positive points).
@@ -28,17 +28,27 @@ pub fn log_log_slope(points: impl IntoIterator<Item = (f64, f64)>) -> Option<f64
     (pts.len() >= 2 && sxx > 0.0).then(|| sxy / sxx)
 }
 
+impl Measurement {
+    /// The RMSE with the reference's own noise taken out:
+    /// √(MSE − Var(reference)) = √(bias² + variance).
+    pub fn own_rmse(&self) -> f64 {
+        (self.bias.bias2 + self.bias.variance).max(0.0).sqrt()
+    }
+}
+
 impl Curve {
-    /// Slope of log RMSE against log time (−0.5 for an unbiased setting
-    /// whose time is proportional to its samples).
+    /// Slope of log [`own_rmse`](Measurement::own_rmse) against log time
+    /// (−0.5 for an unbiased setting whose time is proportional to its
+    /// samples).
     pub fn slope_time(&self) -> Option<f64> {
-        log_log_slope(self.points.iter().map(|p| (p.time, p.metrics.rmse)))
+        log_log_slope(self.points.iter().map(|p| (p.time, p.own_rmse())))
     }
 
-    /// Slope of log RMSE against log spp (−0.5 for an unbiased setting with
-    /// independent samples; steeper for good stratification).
+    /// Slope of log [`own_rmse`](Measurement::own_rmse) against log spp
+    /// (−0.5 for an unbiased setting with independent samples; steeper for
+    /// good stratification).
     pub fn slope_spp(&self) -> Option<f64> {
-        log_log_slope(self.points.iter().map(|p| (p.spp as f64, p.metrics.rmse)))
+        log_log_slope(self.points.iter().map(|p| (p.spp as f64, p.own_rmse())))
     }
 
     /// The last measurement.
@@ -235,7 +245,7 @@ pub fn summary(report: &Report) -> String {
         md,
         "Last measurement of each setting; RMSE at equal time is at {equal_time:.3} s, the \
          time every setting reached. Slopes are of log RMSE against log time and log spp \
-         (−0.5: unbiased Monte Carlo). Bias share is bias² over MSE; z² compares block-mean \
+         (−0.5: unbiased Monte Carlo; the reference's noise taken out). Bias share is bias² over MSE (shown for biased settings); z² compares block-mean \
          differences with their noise (≈ 1 unbiased, > {BIAS_Z2_THRESHOLD} flagged).\n"
     );
     let _ = writeln!(
@@ -248,7 +258,7 @@ pub fn summary(report: &Report) -> String {
         let mse = m.metrics.rmse * m.metrics.rmse;
         let _ = writeln!(
             md,
-            "| {} | {} | {:.3} | {:.4e} | {:.4e} | {:.4e} | {:.4} | {} | {} | {} | {:.0} % | {:.2} | {} |",
+            "| {} | {} | {:.3} | {:.4e} | {:.4e} | {:.4e} | {:.4} | {} | {} | {} | {} | {:.2} | {} |",
             c.setting.label(),
             m.spp,
             m.time,
@@ -259,7 +269,11 @@ pub fn summary(report: &Report) -> String {
             opt(c.rmse_at(equal_time), |v| format!("{v:.4e}")),
             opt(c.slope_time(), |v| format!("{v:.2}")),
             opt(c.slope_spp(), |v| format!("{v:.2}")),
-            100.0 * (m.bias.bias2 / mse).clamp(0.0, 1.0),
+            if c.is_biased() {
+                format!("{:.0} %", 100.0 * (m.bias.bias2 / mse).clamp(0.0, 1.0))
+            } else {
+                "–".to_string()
+            },
             m.bias.block_z2,
             if c.is_biased() { "**yes**" } else { "no" }
         );
@@ -319,4 +333,91 @@ pub fn summary(report: &Report) -> String {
         let _ = writeln!(md, "- {note}");
     }
     md
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accuracy::Axis;
+    use crate::accuracy::metrics::{BiasSplit, Metrics};
+    use crate::accuracy::sweep::{Change, Setting};
+
+    fn point(spp: u32, time: f64, rmse: f64) -> Measurement {
+        Measurement {
+            spp,
+            time,
+            metrics: Metrics {
+                rmse,
+                rel_mse: 0.0,
+                mae: 0.0,
+                flip: 0.0,
+            },
+            bias: BiasSplit {
+                variance: rmse * rmse,
+                bias2: 0.0,
+                block_z2: 1.0,
+            },
+        }
+    }
+
+    fn curve(depth: i32, points: &[(f64, f64)]) -> Curve {
+        Curve {
+            setting: Setting {
+                axis: Axis::MaxDepth,
+                change: Change::MaxDepth(depth),
+            },
+            setup: 0.0,
+            points: points
+                .iter()
+                .enumerate()
+                .map(|(i, &(t, e))| point(2 * 4u32.pow(i as u32), t, e))
+                .collect(),
+            invalid_samples: 0,
+        }
+    }
+
+    #[test]
+    fn slope_of_a_power_law_is_its_exponent() {
+        let pts = (1..6).map(|k| (k as f64, 3.0 * (k as f64).powf(-0.5)));
+        assert!((log_log_slope(pts).unwrap() + 0.5).abs() < 1e-12);
+        assert_eq!(log_log_slope([(1.0, 1.0)]), None);
+        assert_eq!(log_log_slope([(2.0, 1.0), (2.0, 3.0)]), None);
+        let c = curve(2, &[(1.0, 1.0), (4.0, 0.5), (16.0, 0.25)]);
+        assert!((c.slope_time().unwrap() + 0.5).abs() < 1e-12);
+        assert!((c.slope_spp().unwrap() + 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn interpolation_is_log_log_between_measurements() {
+        let c = curve(2, &[(1.0, 1.0), (4.0, 0.5), (16.0, 0.25)]);
+        assert!((c.rmse_at(2.0).unwrap() - 0.5f64.sqrt()).abs() < 1e-12);
+        assert_eq!(c.rmse_at(4.0), Some(0.5));
+        assert_eq!(c.rmse_at(0.5), None);
+        assert_eq!(c.rmse_at(17.0), None);
+        assert!((c.time_to(0.5f64.sqrt()).unwrap() - 2.0).abs() < 1e-12);
+        assert_eq!(c.time_to(2.0), Some(1.0));
+        assert_eq!(c.time_to(0.1), None);
+    }
+
+    #[test]
+    fn pareto_front_keeps_what_nothing_beats() {
+        let a = curve(2, &[(1.0, 1.0), (2.0, 0.8), (4.0, 0.7)]);
+        let b = curve(3, &[(1.5, 0.9), (3.0, 0.5), (6.0, 0.6)]);
+        let curves = [a, b];
+        assert_eq!(pareto_front(&curves), [(0, 0), (1, 0), (0, 1), (1, 1)]);
+        assert_eq!(best_within(&curves, 2.5), Some((0, 1)));
+        assert_eq!(best_within(&curves, 10.0), Some((1, 1)));
+        assert_eq!(best_within(&curves, 0.5), None);
+    }
+
+    #[test]
+    fn bias_flag_follows_the_last_measurement() {
+        let mut c = curve(2, &[(1.0, 1.0), (2.0, 0.9)]);
+        assert!(!c.is_biased());
+        c.points[1].bias.block_z2 = BIAS_Z2_THRESHOLD * 1.5;
+        assert!(c.is_biased());
+        c.points[0].bias.block_z2 = 100.0;
+        c.points[1].bias.block_z2 = 1.0;
+        assert!(!c.is_biased());
+    }
 }

@@ -303,3 +303,98 @@ pub fn measure(
         invalid_samples: twin.invalid_samples(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use radiant_core::{ModuleInfo, Params};
+
+    fn scene(integrator: &str, lights: &str) -> Scene {
+        let text = format!(
+            "integrator: {integrator}\ncamera: {{type: perspective}}\n\
+             film: {{filter: {{type: box}}}}\nlights:\n{lights}"
+        );
+        crate::scene::from_str(&text, "t.yaml".as_ref(), ".".as_ref()).unwrap()
+    }
+
+    struct Constant;
+    impl Sampler for Constant {
+        fn fill_1d(&self, _: &[radiant_core::SampleId], _: u32, out: &mut [f32]) {
+            out.fill(0.5);
+        }
+        fn fill_2d(&self, _: &[radiant_core::SampleId], _: u32, out: &mut [glam::Vec2]) {
+            out.fill(glam::Vec2::splat(0.5));
+        }
+    }
+
+    #[test]
+    fn axis_names_round_trip() {
+        for a in Axis::ALL {
+            assert_eq!(Axis::from_name(a.name()), Some(a));
+        }
+        assert_eq!(Axis::from_name("depth"), None);
+    }
+
+    const POINT: &str = "  - {type: point, position: [0, 0, 1], intensity: 1}\n";
+
+    #[test]
+    fn settings_leave_out_the_scenes_own_values_and_follow_the_registry() {
+        let mut registry = crate::builtin_registry();
+        let one = scene("{type: path, max_depth: 5, rr_depth: 2}", POINT);
+        let (list, notes) = settings(&one, &registry, &Axis::ALL);
+        let labels: Vec<String> = list.iter().map(Setting::label).collect();
+        assert_eq!(
+            labels,
+            [
+                "baseline",
+                "max_depth=2",
+                "max_depth=3",
+                "max_depth=8",
+                "max_depth=-1",
+                "rr_depth=1",
+                "rr_depth=5",
+                "rr_depth=10",
+                "filter=gaussian",
+                "bvh=fast",
+                "bvh=high"
+            ]
+        );
+        assert!(notes.iter().any(|n| n.starts_with("light_selection")));
+        assert!(notes.iter().any(|n| n.starts_with("sampler")));
+
+        // A sampler registered later joins the sweep; two lights allow
+        // light selection.
+        registry.register::<dyn Sampler>(
+            ModuleInfo {
+                type_name: "constant",
+                summary: "",
+                params: &[],
+            },
+            |_: &Params, _| Ok(Box::new(Constant) as Box<dyn Sampler>),
+        );
+        let two = scene("{type: path}", &POINT.repeat(2));
+        let (list, notes) = settings(&two, &registry, &[Axis::Sampler, Axis::LightSelection]);
+        let labels: Vec<String> = list.iter().map(Setting::label).collect();
+        assert_eq!(
+            labels,
+            ["baseline", "sampler=constant", "light_selection=uniform"]
+        );
+        assert!(notes.is_empty());
+        // Each setting extracts with its change applied.
+        let mut two = two;
+        for s in &list {
+            let r = s
+                .extract(&mut two, &registry, &Overrides::default())
+                .unwrap();
+            let expected = match s.change {
+                Change::LightSelection(l) => l,
+                _ => LightSelection::Power,
+            };
+            assert_eq!(r.settings.light_selection, expected);
+        }
+        assert_eq!(
+            two.sampler.type_name, "independent",
+            "the scene is restored"
+        );
+    }
+}

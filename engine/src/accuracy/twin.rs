@@ -95,10 +95,12 @@ impl TwinRender {
     }
 
     /// Renders in passes that double the samples per pixel of each half
-    /// (1, 2, 4, … up to `max_half`), calling `after_pass` after each. A
-    /// pass is not started when it is predicted (from the previous pass and
-    /// `after_pass`'s time) to end later than `limit` after `start`; the
-    /// first pass always runs.
+    /// (1, 2, 4, … up to `max_half`), calling `after_pass` after each. The
+    /// cost of the next pass is predicted from the last one (per sample)
+    /// plus `after_pass`'s time; a pass that would end later than `limit`
+    /// after `start` is cut to the samples that fit, or not started if
+    /// fewer than a quarter of the samples so far would fit. The first pass
+    /// always runs.
     pub fn run_doubling(
         &mut self,
         max_half: u32,
@@ -106,21 +108,27 @@ impl TwinRender {
         limit: Duration,
         mut after_pass: impl FnMut(&Self),
     ) {
+        let max_half = max_half.max(1);
         let mut spp = 1;
+        let mut done = 0;
         loop {
-            let pass = self.advance(spp);
+            let per_sample = self.advance(spp).as_secs_f64() / (spp - done) as f64;
             let after_start = Instant::now();
             after_pass(self);
-            let next = (spp * 2).min(max_half.max(1));
-            // The next pass renders as many new samples as this one had in
-            // all (except after the first): scale this pass's time.
-            let new_now = spp - spp / 2;
-            let predicted =
-                pass.mul_f64((next - spp) as f64 / new_now as f64) + after_start.elapsed();
-            if next == spp || start.elapsed() + predicted > limit {
+            let left = limit.as_secs_f64()
+                - start.elapsed().as_secs_f64()
+                - after_start.elapsed().as_secs_f64();
+            let fit = if per_sample > 0.0 {
+                (left / per_sample).floor().clamp(0.0, u32::MAX as f64) as u32
+            } else {
+                u32::MAX
+            };
+            let more = spp.min(max_half - spp).min(fit);
+            if more == 0 || more < spp / 4 {
                 break;
             }
-            spp = next;
+            done = spp;
+            spp += more;
         }
     }
 
