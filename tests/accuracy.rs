@@ -181,7 +181,8 @@ fn csv_plot_and_summary_are_written_and_parse() {
             "{label} missing from the summary"
         );
     }
-    assert!(md.contains("`filter=box`"), "box filter not flagged:\n{md}");
+    assert!(md.contains("Reference: rendered here"), "{md}");
+    assert!(md.contains("## Notes"), "{md}");
     // The reference was rendered here, so it is written for reuse.
     let written = radiant::film::output::read_exr(dir.path().join(accuracy::REFERENCE_FILE));
     assert_eq!(written.unwrap(), report.reference.image);

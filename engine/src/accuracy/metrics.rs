@@ -10,7 +10,7 @@
 
 use crate::compare::compare;
 use crate::film::Image;
-use crate::film::output::srgb_encode;
+use crate::film::output::to_srgb8;
 
 /// Smallest block edge of the bias test: enough pixels per block for its
 /// variance estimate to be steady.
@@ -61,21 +61,15 @@ pub fn metrics(image: &Image, reference: &Image) -> Option<Metrics> {
     })
 }
 
-fn to_srgb8(image: &Image) -> nv_flip::FlipImageRgb8 {
-    let bytes: Vec<u8> = image
-        .pixels
-        .iter()
-        .flat_map(|p| p.to_array())
-        .map(|c| (srgb_encode(c) * 255.0 + 0.5) as u8)
-        .collect();
-    nv_flip::FlipImageRgb8::with_data(image.width, image.height, &bytes)
+fn flip_image(image: &Image) -> nv_flip::FlipImageRgb8 {
+    nv_flip::FlipImageRgb8::with_data(image.width, image.height, &to_srgb8(image))
 }
 
 /// Mean LDR-FLIP error of `image` against `reference` (same size).
 pub fn flip(image: &Image, reference: &Image) -> f64 {
     let error = nv_flip::flip(
-        to_srgb8(reference),
-        to_srgb8(image),
+        flip_image(reference),
+        flip_image(image),
         nv_flip::DEFAULT_PIXELS_PER_DEGREE,
     );
     nv_flip::FlipPool::from_image(&error).mean() as f64

@@ -19,10 +19,10 @@ pub struct AccuracyArgs {
     #[arg(long)]
     reference: Option<PathBuf>,
     /// Wall-time bound of the sweep in seconds (the reference render excluded).
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, default_value_t = 60.0, allow_negative_numbers = true)]
     budget: f64,
     /// Time for rendering the reference in seconds (default: the budget).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     reference_time: Option<f64>,
     /// Folder for accuracy.csv, accuracy.png, accuracy.md and reference.exr.
     #[arg(long, default_value = "accuracy")]
