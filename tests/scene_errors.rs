@@ -266,3 +266,12 @@ fn bad_light_parameters_are_located_and_explained() {
         &[],
     );
 }
+
+#[test]
+fn unknown_light_selection_lists_the_allowed_ones() {
+    fails_at(
+        &format!("{CAMERA}integrator:\n  type: path\n  light_selection: powr\n"),
+        4,
+        &["powr", "power", "uniform"],
+    );
+}

@@ -126,6 +126,7 @@ fn unlimited_depth_terminates_on_every_scene_of_the_suite() {
                 width: Some(8),
                 height: Some(8),
                 seed: Some(1),
+                ..Default::default()
             },
         );
     }

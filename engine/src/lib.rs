@@ -23,6 +23,7 @@
 //! ```
 
 pub mod accel;
+pub mod accuracy;
 pub mod backend;
 pub mod compare;
 pub mod extract;

@@ -46,6 +46,40 @@ pub struct Rendered {
 
 /// Renders `scene` on all threads of the current rayon pool.
 pub fn render(scene: &RenderScene, progress: &Progress<'_>) -> Rendered {
+    let s = &scene.settings;
+    let mut film = Film::new(s.width, s.height);
+    let pass = render_samples(scene, &mut film, 0..s.spp, progress);
+    Rendered {
+        image: film.develop(),
+        time: pass.time,
+        samples: pass.samples,
+        rays: pass.rays,
+        invalid_samples: film.invalid_samples,
+    }
+}
+
+/// What one call of [`render_samples`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Pass {
+    /// Wall time of the pass.
+    pub time: Duration,
+    /// Camera paths traced (pixels × samples of the pass).
+    pub samples: u64,
+    /// Rays traced (camera, continuation and shadow rays).
+    pub rays: u64,
+}
+
+/// Progressive rendering: renders the sample indices `samples` of every
+/// pixel and adds them to `film`. Calling it with consecutive ranges
+/// (`0..4`, `4..8`, …) accumulates the same image as one render of all
+/// of them, so a caller can develop the film between passes and watch the
+/// estimate converge.
+pub fn render_samples(
+    scene: &RenderScene,
+    film: &mut Film,
+    samples: std::ops::Range<u32>,
+    progress: &Progress<'_>,
+) -> Pass {
     let start = Instant::now();
     let s = &scene.settings;
     let (w, h) = (s.width, s.height);
@@ -53,7 +87,8 @@ pub fn render(scene: &RenderScene, progress: &Progress<'_>) -> Rendered {
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
-    let total = w as u64 * h as u64 * s.spp as u64;
+    let spp = samples.len() as u32;
+    let total = w as u64 * h as u64 * spp as u64;
     let done = std::sync::atomic::AtomicU64::new(0);
     let results: Vec<(TileFilm, u64)> = tiles
         .par_iter()
@@ -63,21 +98,21 @@ pub fn render(scene: &RenderScene, progress: &Progress<'_>) -> Rendered {
             let chunk = (BATCH_PATHS / pixels).max(1);
             let mut tile = TileFilm::new(x0, y0, x1, y1, (w, h), table.radius());
             let rays_before = wave.rays;
-            let mut first = 0;
-            while first < s.spp {
-                let samples = chunk.min(s.spp - first);
+            let mut first = samples.start;
+            while first < samples.end {
+                let count = chunk.min(samples.end - first);
                 let batch = Batch {
                     x0,
                     y0,
                     x1,
                     y1,
                     first_sample: first,
-                    samples,
+                    samples: count,
                 };
                 wave.render(scene, batch, &table, &mut tile);
-                first += samples;
+                first += count;
                 if let Some(f) = progress.callback {
-                    let n = pixels as u64 * samples as u64;
+                    let n = pixels as u64 * count as u64;
                     let d = done.fetch_add(n, std::sync::atomic::Ordering::Relaxed) + n;
                     f(d, total);
                 }
@@ -85,17 +120,14 @@ pub fn render(scene: &RenderScene, progress: &Progress<'_>) -> Rendered {
             (tile, wave.rays - rays_before)
         })
         .collect();
-    let mut film = Film::new(w, h);
     let mut rays = 0;
     for (tile, r) in &results {
         film.merge(tile);
         rays += r;
     }
-    Rendered {
-        image: film.develop(),
+    Pass {
         time: start.elapsed(),
         samples: total,
         rays,
-        invalid_samples: film.invalid_samples,
     }
 }

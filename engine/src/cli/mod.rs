@@ -1,5 +1,6 @@
 //! Command-line parsing (clap) and the subcommands.
 
+mod accuracy;
 mod diagnostic;
 mod info;
 mod modules;
@@ -21,6 +22,8 @@ struct Cli {
 enum Command {
     /// Render a scene to a PNG (tone-mapped sRGB) or EXR (linear) image.
     Render(render::RenderArgs),
+    /// Measure error against time for a sweep of settings (CSV, plot, summary).
+    Accuracy(accuracy::AccuracyArgs),
     /// Print a scene's triangle and light counts, modules and effect set.
     Info {
         /// The scene file.
@@ -49,6 +52,7 @@ pub fn run() -> ExitCode {
     let registry = radiant::builtin_registry();
     let result = match cli.command {
         Command::Render(args) => render::run(&registry, &args),
+        Command::Accuracy(args) => accuracy::run(&registry, &args),
         Command::Info { scene } => info::run(&registry, &scene),
         Command::Modules => {
             modules::run(&registry);

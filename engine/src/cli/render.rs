@@ -82,6 +82,7 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         seed: args.seed,
         width: args.width,
         height: args.height,
+        ..Default::default()
     };
     let render_scene = extract(&scene, registry, &overrides).map_err(report)?;
     for (shape, what) in &render_scene.stats.repaired_shapes {

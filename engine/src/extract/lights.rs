@@ -1,6 +1,8 @@
 //! The light table: every light of the frame and the distribution that
-//! chooses one per next-event estimate, proportional to power.
+//! chooses one per next-event estimate, proportional to power or uniform
+//! ([`LightSelection`]).
 
+use crate::scene::LightSelection;
 use radiant_core::{Effects, Light};
 
 /// The scene's lights with their selection probabilities.
@@ -14,13 +16,17 @@ pub struct LightTable {
 }
 
 impl LightTable {
-    /// Builds the table; lights are chosen in proportion to
-    /// [`Light::power`] (uniformly if no light reports a positive power).
-    pub fn new(lights: Vec<Box<dyn Light>>) -> Self {
+    /// Builds the table; with [`LightSelection::Power`] lights are chosen in
+    /// proportion to [`Light::power`] (uniformly if no light reports a
+    /// positive power), with [`LightSelection::Uniform`] uniformly.
+    pub fn new(lights: Vec<Box<dyn Light>>, selection: LightSelection) -> Self {
         let powers: Vec<f64> = lights
             .iter()
             .map(|l| {
-                let p = l.power() as f64;
+                let p = match selection {
+                    LightSelection::Power => l.power() as f64,
+                    LightSelection::Uniform => 1.0,
+                };
                 if p.is_finite() && p > 0.0 { p } else { 0.0 }
             })
             .collect();
@@ -126,14 +132,16 @@ mod tests {
         }
     }
 
-    #[test]
-    fn selection_is_proportional_to_power() {
-        let table = LightTable::new(vec![
-            Box::new(Fixed(1.0)),
-            Box::new(Fixed(3.0)),
-            Box::new(Fixed(0.0)),
-        ]);
-        let n = 10_000;
+    fn counts(selection: LightSelection) -> [usize; 3] {
+        let table = LightTable::new(
+            vec![
+                Box::new(Fixed(1.0)),
+                Box::new(Fixed(3.0)),
+                Box::new(Fixed(0.0)),
+            ],
+            selection,
+        );
+        let n = 9_999;
         let mut counts = [0usize; 3];
         for i in 0..n {
             let (l, p, r) = table.select((i as f32 + 0.5) / n as f32);
@@ -141,6 +149,21 @@ mod tests {
             assert_eq!(p, table.pmf(l));
             assert!((0.0..1.0).contains(&r));
         }
-        assert_eq!(counts, [2500, 7500, 0]);
+        counts
+    }
+
+    #[test]
+    fn selection_is_proportional_to_power() {
+        let [a, b, c] = counts(LightSelection::Power);
+        assert!(a.abs_diff(2500) <= 1 && b.abs_diff(7499) <= 1 && c == 0);
+    }
+
+    #[test]
+    fn uniform_selection_ignores_power() {
+        assert!(
+            counts(LightSelection::Uniform)
+                .iter()
+                .all(|c| c.abs_diff(3333) <= 1)
+        );
     }
 }

@@ -14,7 +14,7 @@ mod shapes;
 pub use lights::LightTable;
 
 use crate::accel::{Accel, BuildQuality, Primitive};
-use crate::scene::{RenderSettings, Scene, SceneError, module_error};
+use crate::scene::{LightSelection, RenderSettings, Scene, SceneError, module_error};
 use crate::world::{
     CameraPose, EmitterSpec, FlippedNormals, Geometry, LightSpec, MaterialRef, MeshRepairs,
     ModuleSpec, Name, Transform,
@@ -43,6 +43,10 @@ pub struct Overrides {
     pub width: Option<u32>,
     /// Film height.
     pub height: Option<u32>,
+    /// Light selection of next-event estimation.
+    pub light_selection: Option<LightSelection>,
+    /// BVH build quality (default: [`BuildQuality::Medium`]).
+    pub bvh: Option<BuildQuality>,
 }
 
 /// "No emitter" in [`Surfaces::emitter`].
@@ -146,6 +150,9 @@ pub fn extract(
     settings.seed = overrides.seed.unwrap_or(settings.seed);
     settings.width = overrides.width.unwrap_or(settings.width);
     settings.height = overrides.height.unwrap_or(settings.height);
+    settings.light_selection = overrides
+        .light_selection
+        .unwrap_or(settings.light_selection);
 
     let pose = {
         let mut query = scene.world.query::<&CameraPose>();
@@ -290,7 +297,7 @@ pub fn extract(
             ShapePrim::Sphere { centre, radius } => Primitive::Sphere(centre, radius),
         })
         .collect();
-    let (accel, order) = Accel::build(&geometric, BuildQuality::Medium);
+    let (accel, order) = Accel::build(&geometric, overrides.bvh.unwrap_or_default());
     stats.bvh_build = accel.build_time;
     let mut surfaces = Surfaces::default();
     for &i in &order {
@@ -326,7 +333,7 @@ pub fn extract(
         surfaces,
         shaders,
         material_names,
-        lights: LightTable::new(lights),
+        lights: LightTable::new(lights, settings.light_selection),
         camera,
         filter,
         sampler,

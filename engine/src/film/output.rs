@@ -79,13 +79,19 @@ enum Format {
     Exr,
 }
 
-fn write_png(file: &mut std::fs::File, image: &Image) -> Result<(), String> {
-    let bytes: Vec<u8> = image
+/// The image as PNG output shows it: clamped, sRGB-encoded, 8-bit RGB
+/// triples, row-major.
+pub fn to_srgb8(image: &Image) -> Vec<u8> {
+    image
         .pixels
         .iter()
         .flat_map(|p| p.to_array())
         .map(|c| (srgb_encode(c) * 255.0 + 0.5) as u8)
-        .collect();
+        .collect()
+}
+
+fn write_png(file: &mut std::fs::File, image: &Image) -> Result<(), String> {
+    let bytes = to_srgb8(image);
     let buffer = image::RgbImage::from_raw(image.width, image.height, bytes)
         .ok_or("image size does not match its pixels")?;
     let mut w = BufWriter::new(file);

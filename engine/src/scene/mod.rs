@@ -3,7 +3,7 @@
 //! A scene file is a mapping with these keys (all optional but `camera`):
 //!
 //! ```yaml
-//! integrator: {type: path, max_depth: 8, rr_depth: 5}
+//! integrator: {type: path, max_depth: 8, rr_depth: 5, light_selection: power}
 //! film: {width: 256, height: 256, filter: {type: gaussian, stddev: 0.5}}
 //! sampler: {type: independent, spp: 64}
 //! camera: {type: perspective, fov: 40, look_at: {origin: [0, 0, 4], target: [0, 0, 0], up: [0, 1, 0]}}
@@ -60,6 +60,20 @@ pub struct RenderSettings {
     pub rr_depth: u32,
     /// Seed of the sampler.
     pub seed: u64,
+    /// How next-event estimation chooses a light.
+    pub light_selection: LightSelection,
+}
+
+/// How next-event estimation chooses among the scene's lights
+/// (`integrator: {light_selection: …}`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LightSelection {
+    /// In proportion to each light's emitted power.
+    #[default]
+    Power,
+    /// Every light equally likely.
+    Uniform,
 }
 
 /// A loaded scene: the world plus the settings and module definitions that
@@ -112,7 +126,7 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
     let mut top = Mapping::new(file, &doc, "scene")?;
     let mut world = World::new();
 
-    let (max_depth, rr_depth) = parse_integrator(file, top.get("integrator"))?;
+    let (max_depth, rr_depth, light_selection) = parse_integrator(file, top.get("integrator"))?;
     let (width, height, filter) = parse_film(file, top.get("film"))?;
     let (spp, sampler) = parse_sampler(file, top.get("sampler"))?;
 
@@ -186,6 +200,7 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
             max_depth,
             rr_depth,
             seed: 0,
+            light_selection,
         },
         filter,
         sampler,
@@ -201,6 +216,8 @@ struct IntegratorParams {
     max_depth: i32,
     #[serde(default = "five")]
     rr_depth: u32,
+    #[serde(default)]
+    light_selection: LightSelection,
 }
 
 fn unlimited() -> i32 {
@@ -214,8 +231,10 @@ fn five() -> u32 {
 fn parse_integrator(
     file: &Path,
     node: Option<&marked_yaml::Node>,
-) -> Result<(i32, u32), SceneError> {
-    let Some(node) = node else { return Ok((-1, 5)) };
+) -> Result<(i32, u32, LightSelection), SceneError> {
+    let Some(node) = node else {
+        return Ok((-1, 5, LightSelection::default()));
+    };
     let spec = module_spec(file, node, "integrator", &[])?;
     if !INTEGRATORS.contains(&spec.type_name.as_str()) {
         return Err(unknown_type(file, &spec, "integrator", INTEGRATORS));
@@ -234,7 +253,7 @@ fn parse_integrator(
             ),
         ));
     }
-    Ok((p.max_depth, p.rr_depth))
+    Ok((p.max_depth, p.rr_depth, p.light_selection))
 }
 
 #[derive(Deserialize)]
@@ -254,7 +273,8 @@ fn default_height() -> u32 {
     576
 }
 
-fn default_module(type_name: &str) -> ModuleSpec {
+/// A module of type `type_name` with no parameters (its defaults).
+pub(crate) fn default_module(type_name: &str) -> ModuleSpec {
     ModuleSpec {
         type_name: type_name.to_string(),
         location: None,

@@ -1,0 +1,323 @@
+//! Error metrics of one render against the reference, and the split of its
+//! error into bias and variance.
+//!
+//! Every setting is rendered as two independent halves (two sampler seeds),
+//! and so is a reference made by `radiant accuracy`. The halves give the
+//! variance of the combined image at every pixel without a model of the
+//! noise: for independent halves A and B of equal variance, the image
+//! I = (A + B)/2 has Var(I) = E[(A − B)²]/4. What the mean squared error
+//! has beyond the variances of the image and of the reference is bias.
+
+use crate::compare::compare;
+use crate::film::Image;
+use crate::film::output::to_srgb8;
+
+/// Smallest block edge of the bias test: enough pixels per block for its
+/// variance estimate to be steady.
+const MIN_BLOCK: u32 = 8;
+
+/// Median of the χ² distribution with one degree of freedom.
+const CHI2_1_MEDIAN: f64 = 0.454_936_4;
+
+/// How far an image is from the reference.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Metrics {
+    /// Root-mean-square error over pixels and channels.
+    pub rmse: f64,
+    /// Mean of (a − r)² / (r² + 0.01).
+    pub rel_mse: f64,
+    /// Mean absolute error over pixels and channels.
+    pub mae: f64,
+    /// Mean LDR-FLIP error (NVIDIA's perceptual metric, 0 = identical, 1 =
+    /// most different) of the images tone-mapped as PNG output is: clamped,
+    /// sRGB, 8 bit; at 67 pixels per degree (a 0.7 m distance from a 24"
+    /// 4K screen, FLIP's default).
+    pub flip: f64,
+}
+
+/// Measures `image` against `reference`; `None` if their sizes differ.
+pub fn metrics(image: &Image, reference: &Image) -> Option<Metrics> {
+    let c = compare(image, reference)?;
+    let n = (image.pixels.len() * 3).max(1) as f64;
+    let mae = image
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(a, r)| {
+            (*a - *r)
+                .abs()
+                .to_array()
+                .iter()
+                .map(|&d| d as f64)
+                .sum::<f64>()
+        })
+        .sum::<f64>()
+        / n;
+    Some(Metrics {
+        rmse: c.rmse,
+        rel_mse: c.relative_mse,
+        mae,
+        flip: flip(image, reference),
+    })
+}
+
+fn flip_image(image: &Image) -> nv_flip::FlipImageRgb8 {
+    nv_flip::FlipImageRgb8::with_data(image.width, image.height, &to_srgb8(image))
+}
+
+/// Mean LDR-FLIP error of `image` against `reference` (same size).
+pub fn flip(image: &Image, reference: &Image) -> f64 {
+    let error = nv_flip::flip(
+        flip_image(reference),
+        flip_image(image),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    nv_flip::FlipPool::from_image(&error).mean() as f64
+}
+
+/// Two independent renders of the same setting with the same samples per
+/// pixel each.
+#[derive(Debug, Clone, Copy)]
+pub struct Halves<'a> {
+    /// The first half (one sampler seed).
+    pub a: &'a Image,
+    /// The second half (another seed).
+    pub b: &'a Image,
+}
+
+impl Halves<'_> {
+    /// The combined image (A + B)/2.
+    pub fn combined(&self) -> Image {
+        Image {
+            width: self.a.width,
+            height: self.a.height,
+            pixels: self
+                .a
+                .pixels
+                .iter()
+                .zip(&self.b.pixels)
+                .map(|(a, b)| (*a + *b) * 0.5)
+                .collect(),
+        }
+    }
+
+    /// Variance of the combined image, averaged over pixels and channels:
+    /// mean((A − B)²)/4.
+    pub fn variance(&self) -> f64 {
+        let n = (self.a.pixels.len() * 3).max(1) as f64;
+        self.a
+            .pixels
+            .iter()
+            .zip(&self.b.pixels)
+            .map(|(a, b)| (*a - *b).length_squared() as f64)
+            .sum::<f64>()
+            / (4.0 * n)
+    }
+}
+
+/// The bias/variance split of one measurement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BiasSplit {
+    /// Variance of the image (mean over pixels and channels).
+    pub variance: f64,
+    /// Mean squared error less the variances of image and reference: the
+    /// squared bias per pixel and channel (may come out slightly negative
+    /// for an unbiased setting).
+    pub bias2: f64,
+    /// Mean over pixel blocks of the squared block-mean difference divided
+    /// by its expected value without bias: about 1 for an unbiased setting,
+    /// far above 1 for a biased one.
+    pub block_z2: f64,
+}
+
+/// Splits the error of `image` (given as halves) against `reference` (with
+/// its halves if it was rendered here, or `None` for an outside reference
+/// assumed noise-free) into variance and bias.
+///
+/// The bias test compares, over blocks of 1/16 of the image's smaller side
+/// (at least 8 pixels), the mean difference of each block with the spread of
+/// that difference expected from the halves: the variance of a block mean
+/// is estimated from the per-pixel variances scaled by one factor for the
+/// whole image (pixel filters correlate neighbours), the median over blocks
+/// of the squared block-mean half difference over that estimate.
+pub fn bias_split(
+    image: Halves<'_>,
+    reference: &Image,
+    ref_halves: Option<Halves<'_>>,
+) -> BiasSplit {
+    let combined = image.combined();
+    let n = (combined.pixels.len() * 3).max(1) as f64;
+    let mse = combined
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(a, r)| (*a - *r).length_squared() as f64)
+        .sum::<f64>()
+        / n;
+    let variance = image.variance();
+    let ref_variance = ref_halves.map_or(0.0, |h| h.variance());
+    let (w, h) = (combined.width, combined.height);
+    let block = (w.min(h) / 16).max(MIN_BLOCK);
+    let (bw, bh) = (w.div_ceil(block), h.div_ceil(block));
+    let nb = (bw * bh) as usize;
+    // Per block: Σ (I − R), Σ half differences, Σ per-pixel variances, count.
+    let mut d = vec![0.0f64; nb];
+    let mut half = vec![0.0f64; nb];
+    let mut pixel_var = vec![0.0f64; nb];
+    let mut count = vec![0u32; nb];
+    let mean3 = |v: radiant_core::Rgb| (v.x + v.y + v.z) as f64 / 3.0;
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let b = ((y / block) * bw + x / block) as usize;
+            d[b] += mean3(combined.pixels[i] - reference.pixels[i]);
+            let hi = mean3(image.a.pixels[i] - image.b.pixels[i]) / 2.0;
+            let hr = ref_halves.map_or(0.0, |r| mean3(r.a.pixels[i] - r.b.pixels[i]) / 2.0);
+            half[b] += hi + hr;
+            pixel_var[b] += hi * hi + hr * hr;
+            count[b] += 1;
+        }
+    }
+    let mut ratios = Vec::with_capacity(nb);
+    for b in 0..nb {
+        let c = count[b] as f64;
+        d[b] /= c;
+        half[b] /= c;
+        pixel_var[b] /= c * c;
+        if pixel_var[b] > 0.0 {
+            ratios.push(half[b] * half[b] / pixel_var[b]);
+        }
+    }
+    // Each ratio is about correlation × χ²₁, whose median is 0.4549: the
+    // median makes the factor robust to a few blocks of extreme noise.
+    let correlation = if ratios.is_empty() {
+        1.0
+    } else {
+        let mid = ratios.len() / 2;
+        let (_, median, _) = ratios.select_nth_unstable_by(mid, f64::total_cmp);
+        (*median / CHI2_1_MEDIAN).max(1.0)
+    };
+    let (mut z2, mut used) = (0.0, 0usize);
+    for b in 0..nb {
+        let v = correlation * pixel_var[b];
+        if v > 0.0 {
+            z2 += d[b] * d[b] / v;
+            used += 1;
+        }
+    }
+    BiasSplit {
+        variance,
+        bias2: mse - variance - ref_variance,
+        block_z2: if used > 0 { z2 / used as f64 } else { 0.0 },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use radiant_core::Rgb;
+
+    fn image(w: u32, h: u32, f: impl Fn(u32, u32) -> Rgb) -> Image {
+        Image {
+            width: w,
+            height: h,
+            pixels: (0..h)
+                .flat_map(|y| (0..w).map(move |x| (x, y)))
+                .map(|(x, y)| f(x, y))
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn metrics_match_hand_computed_values() {
+        // Differences per channel: pixel 0 (0, 0, 0), pixel 1 (2, −1, 0.5).
+        let r = image(2, 1, |_, _| Rgb::new(1.0, 2.0, 0.5));
+        let a = image(2, 1, |x, _| {
+            if x == 0 {
+                Rgb::new(1.0, 2.0, 0.5)
+            } else {
+                Rgb::new(3.0, 1.0, 1.0)
+            }
+        });
+        let m = metrics(&a, &r).unwrap();
+        assert!((m.rmse - (5.25f64 / 6.0).sqrt()).abs() < 1e-12);
+        assert!((m.mae - 3.5 / 6.0).abs() < 1e-12);
+        let rel = 4.0 / 1.01 + 1.0 / 4.01 + 0.25 / 0.26;
+        assert!((m.rel_mse - rel / 6.0).abs() < 1e-9);
+        assert_eq!(m.flip, flip(&a, &r));
+        assert!(metrics(&a, &image(1, 1, |_, _| Rgb::ONE)).is_none());
+    }
+
+    #[test]
+    fn flip_is_zero_for_equal_images_and_grows_with_the_difference() {
+        let r = image(32, 32, |x, y| Rgb::splat(((x + y) % 7) as f32 / 7.0));
+        assert_eq!(flip(&r, &r), 0.0);
+        let slightly = image(32, 32, |x, y| r.pixels[(y * 32 + x) as usize] * 0.95);
+        let very = image(32, 32, |x, y| r.pixels[(y * 32 + x) as usize] * 0.3);
+        let (s, v) = (flip(&slightly, &r), flip(&very, &r));
+        assert!(0.0 < s && s < v && v <= 1.0, "{s} {v}");
+    }
+
+    #[test]
+    fn variance_and_bias_of_hand_made_halves() {
+        // Reference 1; half A = 1 + β + e everywhere, half B = 1 + β − e on
+        // even and 1 + β + e on odd pixels (e = 0.5). Variance estimate:
+        // mean((A − B)²)/4 = ((2e)²/4 + 0)/2 = 0.125. MSE of the combined
+        // image: (β² + (β + e)²)/2, so bias² = β² + βe.
+        let r = image(32, 32, |_, _| Rgb::ONE);
+        let halves = |beta: f32| {
+            let a = image(32, 32, |_, _| Rgb::splat(1.5 + beta));
+            let b = image(32, 32, |x, y| {
+                Rgb::splat(if (x + y) % 2 == 0 { 0.5 } else { 1.5 } + beta)
+            });
+            (a, b)
+        };
+        for (beta, bias2) in [(0.0, 0.0), (0.1, 0.06)] {
+            let (a, b) = halves(beta);
+            let s = bias_split(Halves { a: &a, b: &b }, &r, None);
+            assert!((s.variance - 0.125).abs() < 1e-9);
+            assert!((s.bias2 - bias2).abs() < 1e-6, "{beta}: {}", s.bias2);
+        }
+        // The reference's own variance is subtracted as well.
+        let (a, b) = halves(0.0);
+        let s = bias_split(Halves { a: &a, b: &b }, &r, Some(Halves { a: &a, b: &b }));
+        assert!((s.bias2 + 0.125).abs() < 1e-9);
+    }
+
+    /// Independent noise in [−0.5, 0.5), blurred over `blur` neighbours in
+    /// x the way a pixel filter correlates neighbours.
+    fn noisy(reference: &Image, seed: u32, offset: f32, blur: u32) -> Image {
+        let w = reference.width;
+        let noise = |x: u32, y: u32, c: u32| {
+            radiant_core::hash::unit_float(radiant_core::hash::hash4(seed, x, y, c)) - 0.5
+        };
+        image(w, reference.height, |x, y| {
+            let mut n = Rgb::ZERO;
+            for k in 0..blur {
+                let xx = (x + k).min(w - 1);
+                n += Rgb::new(noise(xx, y, 0), noise(xx, y, 1), noise(xx, y, 2));
+            }
+            reference.pixels[(y * w + x) as usize] + n / blur as f32 + Rgb::splat(offset)
+        })
+    }
+
+    #[test]
+    fn block_test_tells_bias_from_correlated_noise() {
+        let r = image(128, 128, |x, y| {
+            Rgb::splat(1.0 + ((x / 9 + y / 5) % 3) as f32)
+        });
+        for blur in [1, 4] {
+            let (a, b) = (noisy(&r, 1, 0.0, blur), noisy(&r, 2, 0.0, blur));
+            let unbiased = bias_split(Halves { a: &a, b: &b }, &r, None);
+            assert!(
+                (0.75..1.3).contains(&unbiased.block_z2),
+                "blur {blur}: {unbiased:?}"
+            );
+            // An offset of half the per-pixel noise is found.
+            let sd = unbiased.variance.sqrt() as f32;
+            let (a, b) = (noisy(&r, 1, 0.5 * sd, blur), noisy(&r, 2, 0.5 * sd, blur));
+            let biased = bias_split(Halves { a: &a, b: &b }, &r, None);
+            assert!(biased.block_z2 > 3.0, "blur {blur}: {biased:?}");
+        }
+    }
+}

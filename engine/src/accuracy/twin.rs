@@ -1,0 +1,168 @@
+//! Two independent progressive renders of one setting, with two sampler
+//! seeds, over one extracted scene: the halves whose difference measures
+//! the noise (see [`metrics`](super::metrics)).
+
+use super::metrics::Halves;
+use crate::backend::cpu::{Progress, render_samples};
+use crate::extract::RenderScene;
+use crate::film::{Film, Image};
+use crate::scene::{Scene, SceneError, module_error};
+use glam::UVec2;
+use radiant_core::{BuildContext, Registry, Sampler, TextureTable};
+use std::collections::HashMap;
+use std::time::{Duration, Instant};
+
+/// Two progressive renders of one [`RenderScene`] with different seeds.
+pub struct TwinRender {
+    scene: RenderScene,
+    /// The sampler of the half not being rendered (swapped in turn into
+    /// `scene.sampler`).
+    other: Box<dyn Sampler>,
+    films: [Film; 2],
+    spp: u32,
+    time: Duration,
+}
+
+/// Builds `scene`'s sampler for `seed` the way extract does (samplers use
+/// only the resolution, seed and spp of the context).
+fn build_sampler(
+    scene: &Scene,
+    registry: &Registry,
+    render: &RenderScene,
+    seed: u64,
+) -> Result<Box<dyn Sampler>, SceneError> {
+    let s = &render.settings;
+    let mut textures = TextureTable::default();
+    let named = HashMap::new();
+    let mut ctx = BuildContext::standalone(&scene.dir, &mut textures, &named);
+    ctx.resolution = UVec2::new(s.width, s.height);
+    ctx.seed = seed;
+    ctx.spp = s.spp;
+    registry
+        .build::<dyn Sampler>(&scene.sampler.type_name, &scene.sampler.params, &mut ctx)
+        .map_err(|e| module_error(&scene.file, &scene.sampler, e))
+}
+
+impl TwinRender {
+    /// Prepares the halves: the first uses `render`'s own sampler (built
+    /// for `render.settings.seed`), the second one built for `second_seed`.
+    pub fn new(
+        scene: &Scene,
+        registry: &Registry,
+        render: RenderScene,
+        second_seed: u64,
+    ) -> Result<Self, SceneError> {
+        let other = build_sampler(scene, registry, &render, second_seed)?;
+        let (w, h) = (render.settings.width, render.settings.height);
+        Ok(Self {
+            scene: render,
+            other,
+            films: [Film::new(w, h), Film::new(w, h)],
+            spp: 0,
+            time: Duration::ZERO,
+        })
+    }
+
+    /// Samples per pixel rendered so far in each half.
+    pub fn spp(&self) -> u32 {
+        self.spp
+    }
+
+    /// Render time so far (both halves).
+    pub fn time(&self) -> Duration {
+        self.time
+    }
+
+    /// Renders both halves on to `spp` samples per pixel each; returns the
+    /// time this took.
+    pub fn advance(&mut self, spp: u32) -> Duration {
+        let mut took = Duration::ZERO;
+        if spp > self.spp {
+            for film in &mut self.films {
+                took += render_samples(&self.scene, film, self.spp..spp, &Progress::none()).time;
+                std::mem::swap(&mut self.scene.sampler, &mut self.other);
+            }
+            self.spp = spp;
+        }
+        self.time += took;
+        took
+    }
+
+    /// Renders in passes that double the samples per pixel of each half
+    /// (1, 2, 4, … up to `max_half`), calling `after_pass` after each. The
+    /// cost of the next pass is predicted from the last one (per sample)
+    /// plus `after_pass`'s time; a pass that would end later than `limit`
+    /// after `start` is cut to the samples that fit, or not started if
+    /// fewer than a quarter of the samples so far would fit. The first pass
+    /// always runs.
+    pub fn run_doubling(
+        &mut self,
+        max_half: u32,
+        start: Instant,
+        limit: Duration,
+        mut after_pass: impl FnMut(&Self),
+    ) {
+        let max_half = max_half.max(1);
+        let mut spp = 1;
+        let mut done = 0;
+        loop {
+            let per_sample = self.advance(spp).as_secs_f64() / (spp - done) as f64;
+            let after_start = Instant::now();
+            after_pass(self);
+            let left = limit.as_secs_f64()
+                - start.elapsed().as_secs_f64()
+                - after_start.elapsed().as_secs_f64();
+            let fit = if per_sample > 0.0 {
+                (left / per_sample).floor().clamp(0.0, u32::MAX as f64) as u32
+            } else {
+                u32::MAX
+            };
+            let more = spp.min(max_half - spp).min(fit);
+            if more == 0 || more < spp / 4 {
+                break;
+            }
+            done = spp;
+            spp += more;
+        }
+    }
+
+    /// The two halves developed.
+    pub fn images(&self) -> [Image; 2] {
+        [self.films[0].develop(), self.films[1].develop()]
+    }
+
+    /// Samples that were NaN or infinite (recorded as black), both halves.
+    pub fn invalid_samples(&self) -> u64 {
+        self.films.iter().map(|f| f.invalid_samples).sum()
+    }
+}
+
+/// Developed halves kept together with their combined image.
+#[derive(Debug, Clone)]
+pub struct TwinImages {
+    /// The two halves.
+    pub halves: [Image; 2],
+    /// Their average.
+    pub combined: Image,
+}
+
+impl TwinImages {
+    /// Develops `twin`'s films.
+    pub fn of(twin: &TwinRender) -> Self {
+        let halves = twin.images();
+        let combined = Halves {
+            a: &halves[0],
+            b: &halves[1],
+        }
+        .combined();
+        Self { halves, combined }
+    }
+
+    /// The halves, for the metrics.
+    pub fn halves(&self) -> Halves<'_> {
+        Halves {
+            a: &self.halves[0],
+            b: &self.halves[1],
+        }
+    }
+}

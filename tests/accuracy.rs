@@ -1,0 +1,214 @@
+//! The accuracy/time report on the default scene: error falls as 1/√spp
+//! for the scene as written, max_depth 2 is reported as biased, and the
+//! CSV, plot and summary are written and parse.
+//!
+//! Every run is limited by spp caps far below its time limits, so the
+//! measurements (seeded, thread-count independent) are the same on a
+//! loaded machine as on an idle one.
+
+use radiant::accuracy::report::{CSV_HEADER, log_log_slope};
+use radiant::accuracy::{self, Axis, Config, Reference, Report};
+use radiant::extract::Overrides;
+use radiant_tests::root;
+use std::sync::OnceLock;
+use std::time::Duration;
+
+/// Film size of every run here: small, so each pass is fast.
+const SIZE: u32 = 32;
+/// spp cap of the settings; the reference uses 16 times as many.
+const MAX_SPP: u32 = 256;
+
+fn scene() -> radiant::scene::Scene {
+    radiant::scene::load(root().join("scenes/cornell-box.yaml")).expect("scene loads")
+}
+
+fn config(axes: &[Axis]) -> Config {
+    Config {
+        // Far more than the caps need, so that time never cuts a run short.
+        budget: Duration::from_secs(600),
+        reference_time: Duration::from_secs(600),
+        max_spp: MAX_SPP,
+        axes: axes.to_vec(),
+        overrides: Overrides {
+            width: Some(SIZE),
+            height: Some(SIZE),
+            ..Default::default()
+        },
+        seed: 1,
+    }
+}
+
+/// The reference, rendered once for every test of this file.
+fn reference() -> Reference {
+    static REFERENCE: OnceLock<Reference> = OnceLock::new();
+    REFERENCE
+        .get_or_init(|| {
+            let c = config(&[]);
+            let r = Reference::render(
+                &mut scene(),
+                &radiant::builtin_registry(),
+                &c.overrides,
+                c.reference_time,
+                16 * MAX_SPP,
+            )
+            .expect("reference renders");
+            assert_eq!(r.spp, Some(16 * MAX_SPP), "the reference reached its cap");
+            r
+        })
+        .clone()
+}
+
+/// Runs `config` on the default scene against the shared reference.
+fn sweep(config: &Config) -> Report {
+    accuracy::run(
+        &mut scene(),
+        &radiant::builtin_registry(),
+        config,
+        Some(reference()),
+        &|line| eprintln!("{line}"),
+    )
+    .expect("the sweep runs")
+}
+
+#[test]
+fn error_of_the_default_scene_falls_as_one_over_root_spp() {
+    // The slope of one curve varies by about ±0.05 from seed to seed (a
+    // few pixels at the light's edge dominate the RMSE), so the fit is over
+    // the mean squared error of four independent curves.
+    let mut mse = Vec::new();
+    for seed in [1, 11, 21, 31] {
+        let mut c = config(&[Axis::Spp]);
+        c.seed = seed;
+        let report = sweep(&c);
+        assert_eq!(report.curves.len(), 1);
+        let baseline = &report.curves[0];
+        assert!(!baseline.is_biased(), "seed {seed}: {:?}", baseline.last());
+        let spp: Vec<u32> = baseline.points.iter().map(|p| p.spp).collect();
+        assert_eq!(spp, [2, 4, 8, 16, 32, 64, 128, 256]);
+        mse.resize(spp.len(), 0.0);
+        for (m, p) in mse.iter_mut().zip(&baseline.points) {
+            *m += p.own_rmse().powi(2) / 4.0;
+        }
+        eprintln!("seed {seed}: slope against spp {:?}", baseline.slope_spp());
+    }
+    let points = (1..=8).map(|k| (2f64.powi(k), mse[k as usize - 1].sqrt()));
+    let slope = log_log_slope(points).unwrap();
+    eprintln!("slope of the mean over seeds {slope:.3}");
+    assert!((-0.6..=-0.4).contains(&slope), "slope {slope}");
+}
+
+#[test]
+fn max_depth_2_is_reported_as_biased() {
+    let mut c = config(&[Axis::MaxDepth, Axis::RrDepth]);
+    c.max_spp = 64;
+    let report = sweep(&c);
+    let by_label = |label: &str| {
+        report
+            .curves
+            .iter()
+            .find(|c| c.setting.label() == label)
+            .unwrap_or_else(|| panic!("no setting {label}"))
+    };
+    for c in &report.curves {
+        eprintln!(
+            "{}: z² {:.2}",
+            c.setting.label(),
+            c.last().unwrap().bias.block_z2
+        );
+    }
+    assert!(by_label("max_depth=2").is_biased());
+    assert!(by_label("max_depth=3").is_biased());
+    // Russian roulette does not bias, and the scene as written matches its
+    // own reference.
+    for label in ["baseline", "rr_depth=1", "rr_depth=10"] {
+        assert!(!by_label(label).is_biased(), "{label} reported as biased");
+    }
+    // Missing light shows as bias: most of max_depth 2's error is bias.
+    let last = by_label("max_depth=2").last().unwrap();
+    assert!(
+        last.bias.bias2 > 0.5 * last.metrics.rmse.powi(2),
+        "{last:?}"
+    );
+}
+
+#[test]
+fn csv_plot_and_summary_are_written_and_parse() {
+    let mut c = config(&[Axis::Filter, Axis::Bvh]);
+    c.max_spp = 16;
+    let report = sweep(&c);
+    let dir = tempfile::tempdir().unwrap();
+    accuracy::write(&report, dir.path()).unwrap();
+
+    let csv = std::fs::read_to_string(dir.path().join(accuracy::CSV_FILE)).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some(CSV_HEADER));
+    let columns = CSV_HEADER.split(',').count();
+    let mut rows = 0;
+    let mut pareto = 0;
+    for line in lines {
+        let fields: Vec<&str> = line.split(',').collect();
+        assert_eq!(fields.len(), columns, "{line}");
+        let spp: u32 = fields[3].parse().unwrap();
+        assert!(spp >= 2);
+        for f in &fields[4..12] {
+            let v: f64 = f.parse().unwrap_or_else(|_| panic!("not a number: {f}"));
+            assert!(v.is_finite());
+        }
+        for f in &fields[12..] {
+            assert!(matches!(*f, "true" | "false"), "{f}");
+        }
+        pareto += (fields[13] == "true") as usize;
+        rows += 1;
+    }
+    let expected: usize = report.curves.iter().map(|c| c.points.len()).sum();
+    assert_eq!(rows, expected);
+    assert!(pareto >= 1);
+    let labels: Vec<String> = report.curves.iter().map(|c| c.setting.label()).collect();
+    assert_eq!(labels, ["baseline", "filter=box", "bvh=fast", "bvh=high"]);
+
+    let png = image::open(dir.path().join(accuracy::PLOT_FILE))
+        .unwrap()
+        .to_rgb8();
+    assert_eq!(png.dimensions(), (960, 640));
+    let colours: std::collections::HashSet<[u8; 3]> = png.pixels().map(|p| p.0).collect();
+    assert!(colours.len() > 20, "the plot has {} colours", colours.len());
+
+    let md = std::fs::read_to_string(dir.path().join(accuracy::SUMMARY_FILE)).unwrap();
+    assert!(md.contains("## Best setting for each time budget"));
+    for label in &labels {
+        assert!(
+            md.contains(&format!("| {label} |")),
+            "{label} missing from the summary"
+        );
+    }
+    assert!(md.contains("Reference: rendered here"), "{md}");
+    assert!(md.contains("## Notes"), "{md}");
+    // The reference was rendered here, so it is written for reuse.
+    let written = radiant::film::output::read_exr(dir.path().join(accuracy::REFERENCE_FILE));
+    assert_eq!(written.unwrap(), report.reference.image);
+}
+
+#[test]
+fn progressive_passes_add_up_to_one_render() {
+    use radiant::backend::cpu::{Progress, render, render_samples};
+    let overrides = Overrides {
+        width: Some(SIZE),
+        height: Some(SIZE),
+        spp: Some(8),
+        ..Default::default()
+    };
+    let r = radiant::extract::extract(&scene(), &radiant::builtin_registry(), &overrides).unwrap();
+    let whole = render(&r, &Progress::none()).image;
+    let mut film = radiant::film::Film::new(SIZE, SIZE);
+    for range in [0..1, 1..3, 3..8] {
+        render_samples(&r, &mut film, range, &Progress::none());
+    }
+    let passes = film.develop();
+    for (a, b) in whole.pixels.iter().zip(&passes.pixels) {
+        assert!((*a - *b).abs().max_element() <= 1e-5 * a.max_element().max(1.0));
+    }
+    assert_ne!(
+        whole.pixels,
+        vec![radiant::core::Rgb::ZERO; whole.pixels.len()]
+    );
+}
