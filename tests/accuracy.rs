@@ -164,7 +164,19 @@ fn csv_plot_and_summary_are_written_and_parse() {
     assert_eq!(rows, expected);
     assert!(pareto >= 1);
     let labels: Vec<String> = report.curves.iter().map(|c| c.setting.label()).collect();
-    assert_eq!(labels, ["baseline", "filter=box", "bvh=fast", "bvh=high"]);
+    assert_eq!(
+        labels,
+        [
+            "baseline",
+            "filter=blackman_harris",
+            "filter=box",
+            "filter=lanczos",
+            "filter=mitchell",
+            "filter=tent",
+            "bvh=fast",
+            "bvh=high"
+        ]
+    );
 
     let png = image::open(dir.path().join(accuracy::PLOT_FILE))
         .unwrap()

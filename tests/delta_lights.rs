@@ -10,10 +10,12 @@ use radiant_tests::{Tolerances, render_scene, root};
 const SPP: u32 = 256;
 /// Side of the blocks whose means are compared, in pixels.
 const BLOCK: u32 = 16;
-/// Measured: see the test output.
+/// Measured over seeds 1–6 at 256 spp: channel means within 0.04–0.30 %,
+/// worst 16×16 block 1.3–3.4 %. The channel tolerance still rejects a 3 %
+/// energy error (asserted by `assert_matches`).
 const TOLERANCES: Tolerances = Tolerances {
-    channel_mean: 0.003,
-    block: 0.015,
+    channel_mean: 0.01,
+    block: 0.06,
 };
 
 #[test]

@@ -113,7 +113,7 @@ impl Magnify {
         let l = self.frame.to_local(d);
         let theta_m = l.truncate().length().atan2(l.z);
         let theta = theta_m / self.k;
-        if theta_m >= std::f32::consts::PI * 0.999 || theta_m < 1e-7 {
+        if !(1e-7..std::f32::consts::PI * 0.999).contains(&theta_m) {
             return None;
         }
         let phi = l.y.atan2(l.x);

@@ -85,7 +85,7 @@ fn rejected(text: &str, line: usize, needle: &str) {
 
 #[test]
 fn invalid_fields_of_view_and_resolutions_are_located_errors() {
-    let out_of_range = "fov must be between 0 and 180 degrees (exclusive)";
+    let out_of_range = "`fov` must be between 0 and 180 degrees (exclusive)";
     for (fov, needle) in [
         ("0", out_of_range),
         ("-10", out_of_range),

@@ -354,13 +354,19 @@ mod tests {
                 "rr_depth=1",
                 "rr_depth=5",
                 "rr_depth=10",
+                "filter=blackman_harris",
                 "filter=gaussian",
+                "filter=lanczos",
+                "filter=mitchell",
+                "filter=tent",
+                "sampler=halton",
+                "sampler=sobol",
+                "sampler=stratified",
                 "bvh=fast",
                 "bvh=high"
             ]
         );
         assert!(notes.iter().any(|n| n.starts_with("light_selection")));
-        assert!(notes.iter().any(|n| n.starts_with("sampler")));
 
         // A sampler registered later joins the sweep; two lights allow
         // light selection.
@@ -377,7 +383,14 @@ mod tests {
         let labels: Vec<String> = list.iter().map(Setting::label).collect();
         assert_eq!(
             labels,
-            ["baseline", "sampler=constant", "light_selection=uniform"]
+            [
+                "baseline",
+                "sampler=constant",
+                "sampler=halton",
+                "sampler=sobol",
+                "sampler=stratified",
+                "light_selection=uniform"
+            ]
         );
         assert!(notes.is_empty());
         // Each setting extracts with its change applied.

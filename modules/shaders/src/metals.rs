@@ -4,7 +4,10 @@
 
 use radiant_core::Rgb;
 
-/// (name, η, k) per colour channel.
+/// (name, η, k) per colour channel. The digits are Mitsuba's, kept as
+/// printed (some exceed `f32` precision) so the table can be diffed
+/// against its source.
+#[allow(clippy::excessive_precision)]
 pub(crate) const METALS: &[(&str, [f32; 3], [f32; 3])] = &[
     (
         "a-C",
