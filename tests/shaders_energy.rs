@@ -376,7 +376,6 @@ fn bad_parameters_are_located_errors() {
             "both `alpha_u` and `alpha_v`",
         ),
         ("{type: conductor, alpha: 2}", "[0, 1]"),
-        ("{type: dielectric, int_ior: 1, ext_ior: 1}", "invisible"),
         ("{type: dielectric, int_ior: 0.5}", "≥ 1"),
         (
             "{type: dielectric, int_ior: glas}",

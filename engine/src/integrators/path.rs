@@ -6,6 +6,11 @@
 //! and Russian roulette driven by path throughput from `rr_depth` on —
 //! the estimator of Mitsuba 3's `path` integrator, with the same
 //! `max_depth` semantics (1 = emitters seen directly, 2 = direct light, …).
+//! Unlike Mitsuba, whose survival probability is min(max β, 0.95), a path
+//! survives with probability max β only while that is below 1 (pbrt-v4 and
+//! Cycles): lossless chains through glass and mirrors are not cut at random
+//! and carry no 1/0.95^k weights; unlimited paths stop at
+//! [`UNLIMITED_DEPTH_CAP`] bounces.
 //!
 //! All paths of a batch advance together, one bounce per iteration, so the
 //! bounce count is the same for every live path. Each stage is a loop over
@@ -29,9 +34,10 @@ const CAMERA_DIMS: u32 = 4;
 /// Sampler dimensions used per bounce: light choice, light point (2),
 /// lobe choice, direction (2), Russian roulette, one spare.
 const BOUNCE_DIMS: u32 = 8;
-/// Depth at which unlimited paths (`max_depth: -1`) are cut, as a guard
-/// against scenes where Russian roulette is configured never to start.
-pub const UNLIMITED_DEPTH_CAP: u32 = 1024;
+/// Depth at which unlimited paths (`max_depth: -1`) are cut: the end of
+/// paths that lose no energy (a closed room of perfect mirrors) and of
+/// scenes where Russian roulette is configured never to start.
+pub const UNLIMITED_DEPTH_CAP: u32 = 16384;
 /// Shadow rays stop this fraction short of the light (pbrt's ShadowEpsilon).
 const SHADOW_EPSILON: f32 = 1e-4;
 
@@ -62,6 +68,8 @@ pub struct Wavefront {
     origin: Vec<Vec3>,
     dir: Vec<Vec3>,
     beta: Vec<Rgb>,
+    /// Product of η² over the refractions so far (see [`BsdfSample::eta`]).
+    eta_scale: Vec<f32>,
     radiance: Vec<Rgb>,
     prev_pdf: Vec<f32>,
     hit: Vec<Hit>,
@@ -195,6 +203,8 @@ impl Wavefront {
         for (b, w) in self.beta.iter_mut().zip(&self.u1) {
             *b = Rgb::splat(*w);
         }
+        fit(&mut self.eta_scale, n);
+        self.eta_scale.fill(1.0);
         zeroed(&mut self.radiance, n);
         fit(&mut self.prev_pdf, n);
         fit(&mut self.hit, n);
@@ -569,14 +579,20 @@ impl Wavefront {
             if beta_max <= 0.0 || !beta.is_finite() {
                 continue;
             }
-            if rr {
-                let q = beta_max.min(0.95);
-                if self.u1[k] >= q {
+            // Survival in proportion to throughput without the 1/η² of
+            // refraction (pbrt-v4, Cycles, Mitsuba's η² tracking): a path
+            // whose throughput is still 1 (mirrors, glass) is never killed
+            // at random, so it gathers no 1/q^k weight.
+            let eta_scale = self.eta_scale[i] * s.eta * s.eta;
+            let survival = beta_max * eta_scale;
+            if rr && survival < 1.0 {
+                if self.u1[k] >= survival {
                     continue;
                 }
-                beta /= q;
+                beta /= survival;
             }
             self.beta[i] = beta;
+            self.eta_scale[i] = eta_scale;
             self.prev_pdf[i] = if s.delta { 0.0 } else { s.pdf };
             self.origin[i] = offset_origin(it.p, it.err, it.ng, wi);
             self.dir[i] = wi;

@@ -21,6 +21,25 @@ pub struct Interaction {
     pub uv: Vec2,
 }
 
+/// Least cosine between a shading normal and the geometric normal.
+const MIN_SHADING_COS: f32 = 0.01;
+
+/// Bends shading normal `ns` back above the tangent plane of the geometric
+/// normal `ng` when it lies at or below it (vertex normals that lean over,
+/// or that face the other way): it keeps its tangential direction and gets
+/// a normal component of [`MIN_SHADING_COS`], so that the shading and the
+/// geometric sides of the surface agree and the surface is neither black
+/// nor lit from behind.
+#[inline]
+fn above_tangent_plane(ns: Vec3, ng: Vec3) -> Vec3 {
+    let c = ns.dot(ng);
+    if c >= MIN_SHADING_COS {
+        ns
+    } else {
+        (ns + ng * (MIN_SHADING_COS - c)).normalize()
+    }
+}
+
 /// Resolves `hit` of the ray `origin + t·dir`.
 #[inline]
 pub fn interaction(scene: &RenderScene, hit: &Hit, origin: Vec3, dir: Vec3) -> Interaction {
@@ -34,9 +53,12 @@ pub fn interaction(scene: &RenderScene, hit: &Hit, origin: Vec3, dir: Vec3) -> I
             let ns = if n[0] == Vec3::ZERO {
                 ng
             } else {
-                (n[0] * b0 + n[1] * hit.b1 + n[2] * hit.b2)
-                    .try_normalize()
-                    .unwrap_or(ng)
+                above_tangent_plane(
+                    (n[0] * b0 + n[1] * hit.b1 + n[2] * hit.b2)
+                        .try_normalize()
+                        .unwrap_or(ng),
+                    ng,
+                )
             };
             let uv = scene.surfaces.uvs[i];
             Interaction {
@@ -64,5 +86,27 @@ pub fn interaction(scene: &RenderScene, hit: &Hit, origin: Vec3, dir: Vec3) -> I
                 uv,
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shading_normals_below_the_surface_are_bent_above_it() {
+        let ng = Vec3::Z;
+        // Above the plane: untouched.
+        let ns = Vec3::new(0.6, 0.0, 0.8);
+        assert_eq!(above_tangent_plane(ns, ng), ns);
+        // In the plane and below it: just above, same azimuth.
+        for ns in [Vec3::X, Vec3::new(0.8, 0.0, -0.6)] {
+            let b = above_tangent_plane(ns, ng);
+            assert!((b.length() - 1.0).abs() < 1e-6, "{b}");
+            assert!(b.dot(ng) > 0.0 && b.dot(ng) < 2.0 * MIN_SHADING_COS, "{b}");
+            assert!(b.y.abs() < 1e-6 && b.x > 0.99, "{b}");
+        }
+        // Reversed: the geometric normal.
+        assert!((above_tangent_plane(-Vec3::Z, ng) - ng).length() < 1e-6);
     }
 }

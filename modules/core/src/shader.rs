@@ -30,7 +30,7 @@ impl SurfaceBatch<'_> {
 }
 
 /// The result of sampling a BSDF.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BsdfSample {
     /// The sampled incident direction, local frame.
     pub wi: Vec3,
@@ -41,6 +41,25 @@ pub struct BsdfSample {
     pub pdf: f32,
     /// Whether `wi` came from a delta (perfectly specular) lobe.
     pub delta: bool,
+    /// Relative index of refraction η_t/η_i crossed by a transmitted
+    /// sample (1 for reflection and for unbending transmission). Refraction
+    /// scales radiance by 1/η², which `weight` includes; the integrator
+    /// multiplies it back out for Russian roulette, as Mitsuba 3 does, so
+    /// that a path is not cut for entering glass.
+    pub eta: f32,
+}
+
+impl Default for BsdfSample {
+    /// A failed sample: zero weight and density.
+    fn default() -> Self {
+        Self {
+            wi: Vec3::ZERO,
+            weight: Rgb::ZERO,
+            pdf: 0.0,
+            delta: false,
+            eta: 1.0,
+        }
+    }
 }
 
 /// The result of evaluating a BSDF for a given pair of directions.

@@ -203,6 +203,7 @@ impl Shader for AshikhminShirley {
                     weight: value / pdf,
                     pdf,
                     delta: false,
+                    eta: 1.0,
                 };
             }
         }

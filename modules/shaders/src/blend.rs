@@ -151,6 +151,7 @@ impl Shader for Blend {
                     weight: value / pdf,
                     pdf,
                     delta: false,
+                    eta: s.eta,
                 }
             } else {
                 BsdfSample::default()

@@ -111,6 +111,7 @@ impl Shader for Conductor {
                     weight: self.fresnel.at(wo.z) * spec[i],
                     pdf: 1.0,
                     delta: true,
+                    eta: 1.0,
                 };
                 continue;
             }
@@ -126,6 +127,7 @@ impl Shader for Conductor {
                 weight: self.fresnel.at(wo.dot(m)) * spec[i] * ggx.g1(wi, m),
                 pdf,
                 delta: false,
+                eta: 1.0,
             };
         }
     }

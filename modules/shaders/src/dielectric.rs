@@ -111,6 +111,7 @@ impl Shader for Dielectric {
                         weight: kr[i],
                         pdf: f.r,
                         delta: true,
+                        eta: 1.0,
                     }
                 } else {
                     BsdfSample {
@@ -118,6 +119,7 @@ impl Shader for Dielectric {
                         weight: kt[i] * (f.eta_ti * f.eta_ti),
                         pdf: 1.0 - f.r,
                         delta: true,
+                        eta: f.eta_it,
                     }
                 };
                 continue;
@@ -130,6 +132,11 @@ impl Shader for Dielectric {
                     weight: tint * s.weight,
                     pdf: s.pdf,
                     delta: false,
+                    eta: match (s.transmitted, wo.z > 0.0) {
+                        (false, _) => 1.0,
+                        (true, true) => self.eta,
+                        (true, false) => 1.0 / self.eta,
+                    },
                 };
             }
         }
@@ -173,7 +180,7 @@ impl Shader for Dielectric {
 
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Dielectric, ParamError> {
     let p: DielectricParams = params.parse()?;
-    let eta = relative_ior(&p.int_ior, &p.ext_ior, BK7)?;
+    let eta = relative_ior(&p.int_ior, &p.ext_ior, BK7);
     let reflectance = checked(
         ctx,
         &p.specular_reflectance,
@@ -188,7 +195,10 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Dielectric, Para
         0.0,
         1.0,
     )?;
-    let rough = roughness(&p.alpha, &p.alpha_u, &p.alpha_v, ctx)?;
+    let mut rough = roughness(&p.alpha, &p.alpha_u, &p.alpha_v, ctx)?;
+    // An index-matched interface deflects no ray whatever its microfacets
+    // (and the generalised half vector of Walter et al. vanishes): smooth.
+    rough.smooth |= eta == 1.0;
     let lobes = if rough.smooth {
         Effects::DELTA_LOBES
     } else {

@@ -64,6 +64,7 @@ impl Shader for Diffuse {
                     weight: *a,
                     pdf,
                     delta: false,
+                    eta: 1.0,
                 }
             } else {
                 BsdfSample::default()

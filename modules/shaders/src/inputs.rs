@@ -182,27 +182,17 @@ fn air() -> Ior {
 }
 
 /// The relative index int/ext (defaults: `default_int` inside, air
-/// outside); an index-matched interface is an error, since it would be
-/// invisible.
+/// outside). An index-matched interface (η = 1) is allowed: it refracts
+/// nothing and reflects nothing, so the surface vanishes (Mitsuba 3 refuses
+/// it; an index animated towards 1 or a matched liquid is legitimate).
 pub(crate) fn relative_ior(
     int: &Option<Spanned<Ior>>,
     ext: &Option<Spanned<Ior>>,
     default_int: f32,
-) -> Result<f32, ParamError> {
+) -> f32 {
     let i = int.as_ref().map_or(Ior(default_int), |s| **s);
     let e = ext.as_ref().map_or(air(), |s| **s);
-    let eta = i.0 / e.0;
-    if eta == 1.0 {
-        let message = format!(
-            "`int_ior` equals `ext_ior` ({}): the interface would be invisible; use two different indices",
-            i.0
-        );
-        return Err(match int.as_ref().or(ext.as_ref()) {
-            Some(s) => ParamError::at(s.span(), message),
-            None => ParamError::new(message),
-        });
-    }
-    Ok(eta)
+    i.0 / e.0
 }
 
 /// Resolves the roughness keys of a shader's parameters (serde's `flatten`

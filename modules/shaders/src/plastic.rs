@@ -180,6 +180,7 @@ impl Shader for Plastic {
                             weight: spec[i] * (r / ps),
                             pdf: ps,
                             delta: true,
+                            eta: 1.0,
                         };
                         continue;
                     }
@@ -198,6 +199,7 @@ impl Shader for Plastic {
                     weight: value / pdf,
                     pdf,
                     delta: false,
+                    eta: 1.0,
                 };
             }
         }
@@ -250,7 +252,7 @@ fn rough_interface_albedo(ggx: &Ggx, eta: f32, mu: f32) -> (f32, f32) {
 
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Plastic, ParamError> {
     let p: PlasticParams = params.parse()?;
-    let eta = relative_ior(&p.int_ior, &p.ext_ior, POLYPROPYLENE)?;
+    let eta = relative_ior(&p.int_ior, &p.ext_ior, POLYPROPYLENE);
     let alpha = p.alpha.as_ref().map_or(0.0, |a| **a);
     if let Some(a) = &p.alpha
         && !(0.0..=1.0).contains(&alpha)

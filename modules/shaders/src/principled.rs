@@ -203,6 +203,11 @@ impl Lobes {
                 weight: value / pdf,
                 pdf,
                 delta: false,
+                eta: match (wi.z * wo.z < 0.0, wo.z > 0.0) {
+                    (false, _) => 1.0,
+                    (true, true) => self.eta,
+                    (true, false) => 1.0 / self.eta,
+                },
             }
         } else {
             BsdfSample::default()

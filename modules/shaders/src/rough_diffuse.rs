@@ -118,6 +118,7 @@ impl Shader for RoughDiffuse {
                     weight: oren_nayar(rho[i], scalar(alpha[i]), wo, wi) / pdf,
                     pdf,
                     delta: false,
+                    eta: 1.0,
                 }
             } else {
                 BsdfSample::default()

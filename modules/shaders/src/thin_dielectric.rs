@@ -86,6 +86,7 @@ impl Shader for ThinDielectric {
                     weight: kr[i],
                     pdf: r,
                     delta: true,
+                    eta: 1.0,
                 }
             } else {
                 BsdfSample {
@@ -93,6 +94,7 @@ impl Shader for ThinDielectric {
                     weight: kt[i],
                     pdf: 1.0 - r,
                     delta: true,
+                    eta: 1.0,
                 }
             };
         }
@@ -115,7 +117,7 @@ impl Shader for ThinDielectric {
 
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<ThinDielectric, ParamError> {
     let p: ThinParams = params.parse()?;
-    let eta = relative_ior(&p.int_ior, &p.ext_ior, BK7)?;
+    let eta = relative_ior(&p.int_ior, &p.ext_ior, BK7);
     let reflectance = checked(
         ctx,
         &p.specular_reflectance,

@@ -181,6 +181,7 @@ impl Shader for Ward {
                     weight: value / pdf,
                     pdf,
                     delta: false,
+                    eta: 1.0,
                 };
             }
         }
