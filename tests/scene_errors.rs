@@ -275,3 +275,12 @@ fn unknown_light_selection_lists_the_allowed_ones() {
         &["powr", "power", "uniform"],
     );
 }
+
+#[test]
+fn unknown_filter_sampling_lists_the_allowed_ones() {
+    fails_at(
+        &format!("{CAMERA}film:\n  filter_sampling: importnce\n"),
+        3,
+        &["importnce", "splat", "importance"],
+    );
+}

@@ -13,7 +13,7 @@ use super::reference::Reference;
 use super::twin::{TwinImages, TwinRender};
 use crate::accel::BuildQuality;
 use crate::extract::{Overrides, RenderScene, extract};
-use crate::scene::{LightSelection, Scene, default_module};
+use crate::scene::{FilterSampling, LightSelection, Scene, default_module};
 use crate::world::{EmitterSpec, LightSpec};
 use radiant_core::{Filter, Registry, Sampler};
 use std::fmt;
@@ -30,6 +30,8 @@ pub enum Axis {
     RrDepth,
     /// Every registered pixel filter, with its default parameters.
     Filter,
+    /// How samples reach pixels through the filter (splat, importance).
+    FilterSampling,
     /// Every registered sampler, with its default parameters.
     Sampler,
     /// Light selection of next-event estimation (power, uniform).
@@ -40,11 +42,12 @@ pub enum Axis {
 
 impl Axis {
     /// Every axis, in report order.
-    pub const ALL: [Axis; 7] = [
+    pub const ALL: [Axis; 8] = [
         Axis::Spp,
         Axis::MaxDepth,
         Axis::RrDepth,
         Axis::Filter,
+        Axis::FilterSampling,
         Axis::Sampler,
         Axis::LightSelection,
         Axis::Bvh,
@@ -57,6 +60,7 @@ impl Axis {
             Axis::MaxDepth => "max_depth",
             Axis::RrDepth => "rr_depth",
             Axis::Filter => "filter",
+            Axis::FilterSampling => "filter_sampling",
             Axis::Sampler => "sampler",
             Axis::LightSelection => "light_selection",
             Axis::Bvh => "bvh",
@@ -86,6 +90,8 @@ pub enum Change {
     RrDepth(u32),
     /// The pixel filter type (default parameters).
     Filter(String),
+    /// `film.filter_sampling`.
+    FilterSampling(FilterSampling),
     /// The sampler type (default parameters).
     Sampler(String),
     /// `integrator.light_selection`.
@@ -119,6 +125,8 @@ impl Setting {
             Change::MaxDepth(d) => d.to_string(),
             Change::RrDepth(d) => d.to_string(),
             Change::Filter(t) | Change::Sampler(t) => t.clone(),
+            Change::FilterSampling(FilterSampling::Splat) => "splat".into(),
+            Change::FilterSampling(FilterSampling::Importance) => "importance".into(),
             Change::LightSelection(LightSelection::Power) => "power".into(),
             Change::LightSelection(LightSelection::Uniform) => "uniform".into(),
             Change::Bvh(q) => format!("{q:?}").to_lowercase(),
@@ -157,8 +165,10 @@ impl Setting {
         scene.filter = filter;
         scene.sampler = sampler;
         let mut render = render?;
-        if let Change::RrDepth(d) = self.change {
-            render.settings.rr_depth = d;
+        match self.change {
+            Change::RrDepth(d) => render.settings.rr_depth = d,
+            Change::FilterSampling(f) => render.settings.filter_sampling = f,
+            _ => {}
         }
         Ok(render)
     }
@@ -189,6 +199,11 @@ pub fn settings(scene: &Scene, registry: &Registry, axes: &[Axis]) -> (Vec<Setti
                 .into_iter()
                 .filter(|t| *t != scene.filter.type_name)
                 .map(|t| Change::Filter(t.to_string()))
+                .collect(),
+            Axis::FilterSampling => [FilterSampling::Splat, FilterSampling::Importance]
+                .into_iter()
+                .filter(|f| *f != s.filter_sampling)
+                .map(Change::FilterSampling)
                 .collect(),
             Axis::Sampler => registry
                 .names::<dyn Sampler>()
@@ -359,6 +374,7 @@ mod tests {
                 "filter=lanczos",
                 "filter=mitchell",
                 "filter=tent",
+                "filter_sampling=importance",
                 "sampler=halton",
                 "sampler=sobol",
                 "sampler=stratified",

@@ -3,7 +3,7 @@
 //! merged in tile order (so results do not depend on the thread count).
 
 use crate::extract::RenderScene;
-use crate::film::{Film, FilterTable, Image, TileFilm};
+use crate::film::{Film, Image, Reconstruction, TileFilm};
 use crate::integrators::path::{Batch, Wavefront};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -83,7 +83,7 @@ pub fn render_samples(
     let start = Instant::now();
     let s = &scene.settings;
     let (w, h) = (s.width, s.height);
-    let table = FilterTable::new(scene.filter.as_ref());
+    let reconstruction = Reconstruction::new(scene.filter.as_ref(), s.filter_sampling);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
@@ -96,7 +96,7 @@ pub fn render_samples(
             let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
             let pixels = (x1 - x0) * (y1 - y0);
             let chunk = (BATCH_PATHS / pixels).max(1);
-            let mut tile = TileFilm::new(x0, y0, x1, y1, (w, h), table.radius());
+            let mut tile = TileFilm::new(x0, y0, x1, y1, (w, h), reconstruction.reach());
             let rays_before = wave.rays;
             let mut first = samples.start;
             while first < samples.end {
@@ -109,7 +109,7 @@ pub fn render_samples(
                     first_sample: first,
                     samples: count,
                 };
-                wave.render(scene, batch, &table, &mut tile);
+                wave.render(scene, batch, &reconstruction, &mut tile);
                 first += count;
                 if let Some(f) = progress.callback {
                     let n = pixels as u64 * count as u64;

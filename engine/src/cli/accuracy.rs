@@ -28,8 +28,8 @@ pub struct AccuracyArgs {
     #[arg(long, default_value = "accuracy")]
     out: PathBuf,
     /// Sweep only these axes, comma-separated: spp, max_depth, rr_depth,
-    /// filter, sampler, light_selection, bvh (the scene as written is always
-    /// measured).
+    /// filter, filter_sampling, sampler, light_selection, bvh (the scene as
+    /// written is always measured).
     #[arg(long, value_delimiter = ',')]
     only: Vec<String>,
     /// Largest samples per pixel of a setting.

@@ -4,12 +4,16 @@
 //! pixels plus the filter's border; tiles are merged into the [`Film`] in a
 //! fixed order, so a render is bit-identical whatever the thread count.
 //! A pixel's value is Σ w·L / Σ w over the samples whose filter footprint
-//! covers it (Mitsuba 3 and pbrt semantics).
+//! covers it (Mitsuba 3 and pbrt semantics). [`Reconstruction`] chooses
+//! how samples get their weights: splatted into every pixel in the
+//! filter's reach ([`FilterTable`]), or placed by filter importance
+//! sampling and added to one pixel ([`FilterSampler`], pbrt-v4).
 
 pub mod output;
 
+use crate::scene::FilterSampling;
 use glam::{Vec2, Vec4};
-use radiant_core::{Filter, Rgb};
+use radiant_core::{Filter, FilterSampler, Rgb};
 
 /// Entries per axis of the tabulated filter quadrant.
 const TABLE_RES: usize = 64;
@@ -116,6 +120,38 @@ impl Image {
     }
 }
 
+/// How samples reach the pixels through the pixel filter, prepared once per
+/// render.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Reconstruction {
+    /// Samples uniform in their pixel, splatted with the tabulated filter.
+    Splat(FilterTable),
+    /// Sample offsets drawn in proportion to |f|, each added to its own
+    /// pixel with weight f/pdf.
+    Importance(FilterSampler),
+}
+
+impl Reconstruction {
+    /// Prepares `filter` for `sampling`.
+    pub fn new(filter: &dyn Filter, sampling: FilterSampling) -> Self {
+        match sampling {
+            FilterSampling::Splat => Self::Splat(FilterTable::new(filter)),
+            FilterSampling::Importance => Self::Importance(FilterSampler::new(
+                filter,
+                FilterSampler::DEFAULT_RESOLUTION,
+            )),
+        }
+    }
+
+    /// How far, in pixels, a sample reaches beyond its own pixel.
+    pub fn reach(&self) -> f32 {
+        match self {
+            Self::Splat(table) => table.radius(),
+            Self::Importance(_) => 0.0,
+        }
+    }
+}
+
 /// The weighted sums of one render task's pixels, with a border as wide as
 /// the filter.
 #[derive(Debug, Clone)]
@@ -198,6 +234,22 @@ impl TileFilm {
                 }
             }
         }
+    }
+}
+
+impl TileFilm {
+    /// Adds `value` with filter weight `weight` to pixel (`x`, `y`) alone
+    /// (filter importance sampling).
+    #[inline]
+    pub fn add(&mut self, x: u32, y: u32, value: Rgb, weight: f32) {
+        let value = if value.is_finite() {
+            value
+        } else {
+            self.invalid_samples += 1;
+            Rgb::ZERO
+        };
+        let i = ((y as i32 - self.y0) * self.width + x as i32 - self.x0) as usize;
+        self.sums[i] += (value * weight).extend(weight);
     }
 }
 
@@ -291,6 +343,44 @@ mod tests {
         let image = film.develop();
         for p in &image.pixels {
             assert!((*p - Rgb::new(0.25, 0.5, 1.0)).abs().max_element() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn importance_sampled_samples_stay_in_their_pixel() {
+        let r = Reconstruction::new(&Tent, FilterSampling::Importance);
+        assert_eq!(r.reach(), 0.0);
+        assert_eq!(
+            Reconstruction::new(&Tent, FilterSampling::Splat).reach(),
+            1.5
+        );
+        let Reconstruction::Importance(sampler) = &r else {
+            panic!("importance sampling expected");
+        };
+        let (w, h) = (4u32, 3u32);
+        let mut film = Film::new(w, h);
+        let mut tile = TileFilm::new(1, 1, 3, 3, (w, h), r.reach());
+        for (k, (x, y)) in [(1, 1), (2, 1), (1, 2), (2, 2)].into_iter().enumerate() {
+            for s in 0..8 {
+                let u = Vec2::new((s as f32 + 0.5) / 8.0, ((s * 3 + k) % 8) as f32 / 8.0);
+                let (_, weight) = sampler.sample(u);
+                // The tent is positive: every weight is its integral, 2.25².
+                assert!((weight - 5.0625).abs() < 0.01, "{weight}");
+                tile.add(x, y, Rgb::splat(x as f32 + 10.0 * y as f32), weight);
+            }
+        }
+        film.merge(&tile);
+        let image = film.develop();
+        for y in 0..h {
+            for x in 0..w {
+                let expected = if (1..3).contains(&x) && (1..3).contains(&y) {
+                    x as f32 + 10.0 * y as f32
+                } else {
+                    0.0
+                };
+                let p = image.pixels[(y * w + x) as usize];
+                assert!((p.x - expected).abs() < 1e-5, "({x}, {y}): {p}");
+            }
         }
     }
 

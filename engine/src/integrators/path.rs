@@ -22,7 +22,7 @@ use super::surface::{Interaction, interaction};
 use crate::accel::Hit;
 use crate::accel::offset::{offset_origin, sampled_point_error};
 use crate::extract::{NO_EMITTER, RenderScene};
-use crate::film::{FilterTable, TileFilm};
+use crate::film::{Reconstruction, TileFilm};
 use glam::{Vec2, Vec3};
 use radiant_core::{
     BsdfEval, BsdfSample, CameraRays, Effects, EmitterEval, EmitterHit, LightSample, Rgb, SampleId,
@@ -64,7 +64,10 @@ pub struct Batch {
 pub struct Wavefront {
     // Path state, indexed by slot.
     ids: Vec<SampleId>,
+    /// Raster positions of the camera samples.
     film: Vec<Vec2>,
+    /// Filter weights f/pdf of the samples (filter importance sampling).
+    filter_weight: Vec<f32>,
     origin: Vec<Vec3>,
     dir: Vec<Vec3>,
     beta: Vec<Rgb>,
@@ -147,25 +150,47 @@ fn bsdf_hit_weight(depth: u32, bsdf_pdf: f32, light_pdf: f32) -> f32 {
 }
 
 impl Wavefront {
-    /// Renders `batch` and splats its samples into `tile`.
+    /// Renders `batch` and adds its samples to `tile`.
     pub fn render(
         &mut self,
         scene: &RenderScene,
         batch: Batch,
-        table: &FilterTable,
+        reconstruction: &Reconstruction,
         tile: &mut TileFilm,
     ) {
         let n = ((batch.x1 - batch.x0) * (batch.y1 - batch.y0) * batch.samples) as usize;
-        self.generate(scene, batch, n);
+        self.generate(scene, batch, n, reconstruction);
         if scene.settings.max_depth != 0 {
             self.trace_paths(scene);
         }
-        for i in 0..n {
-            tile.splat(self.film[i], self.radiance[i], table);
+        match reconstruction {
+            Reconstruction::Splat(table) => {
+                for i in 0..n {
+                    tile.splat(self.film[i], self.radiance[i], table);
+                }
+            }
+            Reconstruction::Importance(_) => {
+                let width = scene.settings.width;
+                for i in 0..n {
+                    let pixel = self.ids[i].pixel;
+                    tile.add(
+                        pixel % width,
+                        pixel / width,
+                        self.radiance[i],
+                        self.filter_weight[i],
+                    );
+                }
+            }
         }
     }
 
-    fn generate(&mut self, scene: &RenderScene, b: Batch, n: usize) {
+    fn generate(
+        &mut self,
+        scene: &RenderScene,
+        b: Batch,
+        n: usize,
+        reconstruction: &Reconstruction,
+    ) {
         let width = scene.settings.width;
         fit(&mut self.ids, n);
         let mut i = 0;
@@ -184,6 +209,16 @@ impl Wavefront {
         fit(&mut self.u2, n);
         scene.sampler.fill_2d(&self.ids, 0, &mut self.film);
         scene.sampler.fill_2d(&self.ids, 2, &mut self.u2);
+        if let Reconstruction::Importance(filter) = reconstruction {
+            // The sample's offset from its pixel's centre, drawn from the
+            // filter, and its weight f/pdf.
+            fit(&mut self.filter_weight, n);
+            for (f, w) in self.film.iter_mut().zip(&mut self.filter_weight) {
+                let (offset, weight) = filter.sample(*f);
+                *f = Vec2::splat(0.5) + offset;
+                *w = weight;
+            }
+        }
         for (f, id) in self.film.iter_mut().zip(&self.ids) {
             *f += Vec2::new((id.pixel % width) as f32, (id.pixel / width) as f32);
         }
