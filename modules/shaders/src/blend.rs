@@ -12,8 +12,8 @@ use crate::inputs::{checked, scalar, texture_effects};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamDoc, ParamError, Params,
-    Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 use serde::de::IgnoredAny;
@@ -228,13 +228,12 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Blend, ParamErro
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "blend",
-            summary: "Mix of two materials by a weight texture.",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "blend",
+        "Mix of two materials by a weight texture.",
+        DOCS,
+        build,
     );
 }
 

@@ -11,7 +11,7 @@ use crate::microfacet::{Ggx, reflect};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, Color, Effects, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb,
+    BsdfEval, BsdfSample, Color, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
     ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
@@ -240,13 +240,12 @@ fn build(
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "conductor",
-            summary: "Metal: smooth mirror or rough GGX (visible-normal sampling), isotropic or anisotropic, complex-IOR presets.",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "conductor",
+        "Metal: smooth mirror or rough GGX (visible-normal sampling), isotropic or anisotropic, complex-IOR presets.",
+        DOCS,
+        build,
     );
 }
 

@@ -14,8 +14,8 @@ use crate::microfacet::Ggx;
 use radiant_core::glam::Vec3;
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamDoc, ParamError, Params,
-    Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 
@@ -216,13 +216,12 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Dielectric, Para
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "dielectric",
-            summary: "Glass-like interface: smooth (exact Fresnel, total internal reflection) or rough (Walter et al. 2007, GGX visible normals).",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "dielectric",
+        "Glass-like interface: smooth (exact Fresnel, total internal reflection) or rough (Walter et al. 2007, GGX visible normals).",
+        DOCS,
+        build,
     );
 }
 

@@ -4,8 +4,8 @@ use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use radiant_core::{
-    BsdfEval, BsdfSample, Effects, ModuleInfo, ParamDoc, Params, Registry, Rgb, ShadeContext,
-    Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 use std::f32::consts::FRAC_1_PI;
@@ -97,19 +97,20 @@ impl Shader for Diffuse {
     }
 }
 
+fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Diffuse, ParamError> {
+    let p: DiffuseParams = params.parse()?;
+    let reflectance = ctx.texture(&p.reflectance)?;
+    let effects = ctx.textures.effects(reflectance);
+    Ok(Diffuse::new(reflectance, effects))
+}
+
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "diffuse",
-            summary: "Ideal one-sided Lambertian reflector.",
-            params: DOCS,
-        },
-        |params: &Params, ctx| {
-            let p: DiffuseParams = params.parse()?;
-            let reflectance = ctx.texture(&p.reflectance)?;
-            let effects = ctx.textures.effects(reflectance);
-            Ok(Box::new(Diffuse::new(reflectance, effects)) as Box<dyn Shader>)
-        },
+    crate::register_shader(
+        registry,
+        "diffuse",
+        "Ideal one-sided Lambertian reflector.",
+        DOCS,
+        build,
     );
 }
 

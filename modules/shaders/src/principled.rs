@@ -25,8 +25,8 @@ use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamDoc, ParamError, Params,
-    Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput, luminance,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput, luminance,
 };
 use serde::Deserialize;
 use std::f32::consts::PI;
@@ -296,13 +296,12 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Principled, Para
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "principled",
-            summary: "Metalness workflow: GGX reflection, coupled diffuse and rough transmission mixed by metalness and transmission.",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "principled",
+        "Metalness workflow: GGX reflection, coupled diffuse and rough transmission mixed by metalness and transmission.",
+        DOCS,
+        build,
     );
 }
 

@@ -8,8 +8,8 @@ use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamDoc, ParamError, Params,
-    Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 use std::f32::consts::{FRAC_1_PI, SQRT_2};
@@ -164,13 +164,12 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<RoughDiffuse, Pa
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "rough_diffuse",
-            summary: "Oren–Nayar rough diffuse reflector (full model with interreflection, as Mitsuba 3).",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "rough_diffuse",
+        "Oren–Nayar rough diffuse reflector (full model with interreflection, as Mitsuba 3).",
+        DOCS,
+        build,
     );
 }
 

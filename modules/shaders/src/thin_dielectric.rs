@@ -9,8 +9,8 @@ use crate::inputs::{BK7, Ior, checked, relative_ior, texture_effects};
 use radiant_core::glam::Vec3;
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamDoc, ParamError, Params,
-    Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 
@@ -143,13 +143,12 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<ThinDielectric, 
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "thin_dielectric",
-            summary: "Thin dielectric slab: internal reflections summed, no refraction (both lobes delta).",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "thin_dielectric",
+        "Thin dielectric slab: internal reflections summed, no refraction (both lobes delta).",
+        DOCS,
+        build,
     );
 }
 
