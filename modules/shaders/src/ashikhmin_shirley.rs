@@ -11,7 +11,7 @@
 
 use crate::fresnel::schlick;
 use crate::half_vector::{HalfVectorLobes, HalfVectorShader, specular_probability};
-use crate::inputs::{checked, scalar};
+use crate::inputs::{checked, fraction, scalar};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::cosine_hemisphere_pdf;
@@ -169,14 +169,8 @@ fn build(
     ctx: &mut BuildContext<'_>,
 ) -> Result<HalfVectorShader<Lobes>, ParamError> {
     let p: AsParams = params.parse()?;
-    let diffuse = checked(ctx, &p.diffuse_reflectance, "diffuse_reflectance", 0.0, 1.0)?;
-    let specular = checked(
-        ctx,
-        &p.specular_reflectance,
-        "specular_reflectance",
-        0.0,
-        1.0,
-    )?;
+    let diffuse = fraction(ctx, &p.diffuse_reflectance, "diffuse_reflectance")?;
+    let specular = fraction(ctx, &p.specular_reflectance, "specular_reflectance")?;
     let nu = checked(ctx, &p.exponent_u, "exponent_u", 0.0, MAX_EXPONENT)?;
     let nv = checked(ctx, &p.exponent_v, "exponent_v", 0.0, MAX_EXPONENT)?;
     Ok(HalfVectorShader::new(ctx, [diffuse, specular, nu, nv]))

@@ -8,7 +8,7 @@
 //! keeps its component's weight, which is unbiased for the mix (a delta
 //! lobe of one component is not evaluated through the other).
 
-use crate::inputs::{checked, scalar, texture_effects};
+use crate::inputs::{fraction, scalar, texture_effects};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::{
@@ -205,7 +205,7 @@ impl Shader for Blend {
 
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Blend, ParamError> {
     let p: BlendParams = params.parse()?;
-    let weight = checked(ctx, &p.weight, "weight", 0.0, 1.0)?;
+    let weight = fraction(ctx, &p.weight, "weight")?;
     let list = params
         .node()
         .as_mapping()

@@ -1,5 +1,6 @@
 //! The `diffuse` shader: an ideal one-sided Lambertian reflector.
 
+use crate::lobes::reflection_sample;
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
@@ -59,13 +60,7 @@ impl Shader for Diffuse {
             let wi = square_to_cosine_hemisphere(Vec2::new(u.y, u.z));
             let pdf = cosine_hemisphere_pdf(wi);
             *o = if wo.z > 0.0 && pdf > 0.0 {
-                BsdfSample {
-                    wi,
-                    weight: *a,
-                    pdf,
-                    delta: false,
-                    eta: 1.0,
-                }
+                reflection_sample(wi, *a, pdf)
             } else {
                 BsdfSample::default()
             };

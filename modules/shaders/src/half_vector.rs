@@ -5,6 +5,7 @@
 //! The models differ only in their [`HalfVectorLobes`].
 
 use crate::inputs::texture_effects;
+use crate::lobes::reflection_sample;
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::warp::square_to_cosine_hemisphere;
 use radiant_core::{
@@ -82,13 +83,7 @@ impl<L: HalfVectorLobes> Shader for HalfVectorShader<L> {
             };
             let (value, pdf) = lobes.eval(wo, wi);
             if pdf > 0.0 {
-                *o = BsdfSample {
-                    wi,
-                    weight: value / pdf,
-                    pdf,
-                    delta: false,
-                    eta: 1.0,
-                };
+                *o = reflection_sample(wi, value / pdf, pdf);
             }
         }
     }

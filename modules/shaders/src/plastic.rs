@@ -7,8 +7,8 @@
 //! transmittance.
 
 use crate::fresnel;
-use crate::inputs::{Ior, checked, relative_ior, scalar, texture_effects};
-use crate::lobes::{glossy_eval, glossy_sample};
+use crate::inputs::{Ior, fraction, relative_ior, scalar, texture_effects};
+use crate::lobes::{glossy_eval, glossy_sample, mirror_sample, reflection_sample};
 use crate::microfacet::{Ggx, reflect, refract};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
@@ -175,13 +175,7 @@ impl Shader for Plastic {
                 match &self.ggx {
                     None => {
                         let r = fresnel::dielectric(wo.z, self.eta).r;
-                        *o = BsdfSample {
-                            wi: Vec3::new(-wo.x, -wo.y, wo.z),
-                            weight: spec[i] * (r / ps),
-                            pdf: ps,
-                            delta: true,
-                            eta: 1.0,
-                        };
+                        *o = mirror_sample(wo, spec[i] * (r / ps), ps);
                         continue;
                     }
                     Some(ggx) => match glossy_sample(ggx, wo, u2) {
@@ -194,13 +188,7 @@ impl Shader for Plastic {
             };
             let (value, pdf) = self.eval_point(albedo[i], spec[i], wo, wi);
             if pdf > 0.0 && wi.z > 0.0 {
-                *o = BsdfSample {
-                    wi,
-                    weight: value / pdf,
-                    pdf,
-                    delta: false,
-                    eta: 1.0,
-                };
+                *o = reflection_sample(wi, value / pdf, pdf);
             }
         }
     }
@@ -262,14 +250,8 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Plastic, ParamEr
             format!("`alpha` must lie in [0, 1], found {alpha}"),
         ));
     }
-    let diffuse = checked(ctx, &p.diffuse_reflectance, "diffuse_reflectance", 0.0, 1.0)?;
-    let specular = checked(
-        ctx,
-        &p.specular_reflectance,
-        "specular_reflectance",
-        0.0,
-        1.0,
-    )?;
+    let diffuse = fraction(ctx, &p.diffuse_reflectance, "diffuse_reflectance")?;
+    let specular = fraction(ctx, &p.specular_reflectance, "specular_reflectance")?;
     let d_mean = scalar(ctx.textures.mean(diffuse));
     let s_mean = scalar(ctx.textures.mean(specular));
     let specular_weight = if d_mean + s_mean > 0.0 {

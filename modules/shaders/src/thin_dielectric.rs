@@ -5,7 +5,8 @@
 
 use crate::dielectric::{EXT_IOR_DOC, INT_IOR_DOC};
 use crate::fresnel;
-use crate::inputs::{BK7, Ior, checked, relative_ior, texture_effects};
+use crate::inputs::{BK7, Ior, fraction, relative_ior, texture_effects};
+use crate::lobes::mirror_sample;
 use radiant_core::glam::Vec3;
 use radiant_core::params::Spanned;
 use radiant_core::{
@@ -81,13 +82,7 @@ impl Shader for ThinDielectric {
             }
             let r = slab_reflectance(fresnel::dielectric(wo.z.abs(), self.eta).r);
             *o = if u[i].x <= r {
-                BsdfSample {
-                    wi: Vec3::new(-wo.x, -wo.y, wo.z),
-                    weight: kr[i],
-                    pdf: r,
-                    delta: true,
-                    eta: 1.0,
-                }
+                mirror_sample(wo, kr[i], r)
             } else {
                 BsdfSample {
                     wi: -wo,
@@ -118,20 +113,8 @@ impl Shader for ThinDielectric {
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<ThinDielectric, ParamError> {
     let p: ThinParams = params.parse()?;
     let eta = relative_ior(&p.int_ior, &p.ext_ior, BK7);
-    let reflectance = checked(
-        ctx,
-        &p.specular_reflectance,
-        "specular_reflectance",
-        0.0,
-        1.0,
-    )?;
-    let transmittance = checked(
-        ctx,
-        &p.specular_transmittance,
-        "specular_transmittance",
-        0.0,
-        1.0,
-    )?;
+    let reflectance = fraction(ctx, &p.specular_reflectance, "specular_reflectance")?;
+    let transmittance = fraction(ctx, &p.specular_transmittance, "specular_transmittance")?;
     Ok(ThinDielectric {
         eta,
         reflectance,

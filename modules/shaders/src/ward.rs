@@ -6,7 +6,7 @@
 //! f = ρd/π + ρs · exp(−tan²θh (cos²φh/αu² + sin²φh/αv²)) / (4π αu αv (wi·h)² cos⁴θh).
 
 use crate::half_vector::{HalfVectorLobes, HalfVectorShader, specular_probability};
-use crate::inputs::{checked, scalar};
+use crate::inputs::{checked, fraction, scalar};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::cosine_hemisphere_pdf;
@@ -153,14 +153,8 @@ fn build(
             ),
         ));
     }
-    let diffuse = checked(ctx, &p.diffuse_reflectance, "diffuse_reflectance", 0.0, 1.0)?;
-    let specular = checked(
-        ctx,
-        &p.specular_reflectance,
-        "specular_reflectance",
-        0.0,
-        1.0,
-    )?;
+    let diffuse = fraction(ctx, &p.diffuse_reflectance, "diffuse_reflectance")?;
+    let specular = fraction(ctx, &p.specular_reflectance, "specular_reflectance")?;
     let alpha_u = checked(ctx, &p.alpha_u, "alpha_u", MIN_ALPHA, 1.0)?;
     let alpha_v = checked(ctx, &p.alpha_v, "alpha_v", MIN_ALPHA, 1.0)?;
     Ok(HalfVectorShader::new(
