@@ -19,7 +19,9 @@ pub use projection::{FovAxis, InvalidParam};
 pub use spherical::Spherical;
 pub use thin_lens::ThinLens;
 
-use radiant_core::Registry;
+use radiant_core::glam::{Mat4, Vec2};
+use radiant_core::{BuildContext, Camera, ModuleInfo, ParamDoc, Params, Registry};
+use serde::de::DeserializeOwned;
 
 /// Registers every built-in camera type.
 pub fn register(registry: &mut Registry) {
@@ -27,6 +29,34 @@ pub fn register(registry: &mut Registry) {
     thin_lens::register(registry);
     orthographic::register(registry);
     spherical::register(registry);
+}
+
+/// Registers the camera type `type_name`: `make` builds it from its
+/// parameters `P`, the pose (camera to render space) and the film
+/// resolution; a parameter out of range is reported at its key.
+fn register_camera<P: DeserializeOwned + 'static, C: Camera + 'static>(
+    registry: &mut Registry,
+    type_name: &'static str,
+    summary: &'static str,
+    params: &'static [ParamDoc],
+    make: fn(P, Mat4, Vec2) -> Result<C, InvalidParam>,
+) {
+    registry.register::<dyn Camera>(
+        ModuleInfo {
+            type_name,
+            summary,
+            params,
+        },
+        move |params: &Params, ctx: &mut BuildContext<'_>| {
+            let camera = make(
+                params.parse()?,
+                ctx.camera_to_render,
+                ctx.resolution.as_vec2(),
+            )
+            .map_err(|e| e.at(params))?;
+            Ok(Box::new(camera) as Box<dyn Camera>)
+        },
+    );
 }
 
 #[cfg(test)]

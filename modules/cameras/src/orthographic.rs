@@ -7,7 +7,7 @@
 
 use crate::projection::{InvalidParam, Raster, check_min};
 use radiant_core::glam::{Mat4, Vec2, Vec3};
-use radiant_core::{BuildContext, Camera, CameraRays, ModuleInfo, ParamDoc, Params, Registry};
+use radiant_core::{Camera, CameraRays, ParamDoc, Registry};
 use serde::Deserialize;
 
 #[derive(Debug, Deserialize)]
@@ -65,17 +65,13 @@ impl Camera for Orthographic {
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Camera>(
-        ModuleInfo {
-            type_name: "orthographic",
-            summary: "Parallel projection along the view direction. Pose from `look_at` or `transform`.",
-            params: DOCS,
-        },
-        |params: &Params, ctx: &mut BuildContext<'_>| {
-            let p: OrthographicParams = params.parse()?;
-            let camera = Orthographic::new(ctx.camera_to_render, ctx.resolution.as_vec2(), p.width)
-                .map_err(|e| e.at(params))?;
-            Ok(Box::new(camera) as Box<dyn Camera>)
+    crate::register_camera(
+        registry,
+        "orthographic",
+        "Parallel projection along the view direction. Pose from `look_at` or `transform`.",
+        DOCS,
+        |p: OrthographicParams, to_render, resolution| {
+            Orthographic::new(to_render, resolution, p.width)
         },
     );
 }

@@ -1,8 +1,10 @@
 //! The `perspective` camera: an ideal pinhole.
 
-use crate::projection::{FOV_AXIS_DOC, FOV_DOC, FovAxis, InvalidParam, Pinhole, default_fov};
-use radiant_core::glam::{Mat4, Vec2, Vec3};
-use radiant_core::{BuildContext, Camera, CameraRays, ModuleInfo, ParamDoc, Params, Registry};
+use crate::projection::{
+    FOV_AXIS_DOC, FOV_DOC, FovAxis, InvalidParam, Pinhole, central_rays, default_fov,
+};
+use radiant_core::glam::{Mat4, Vec2};
+use radiant_core::{Camera, CameraRays, ParamDoc, Registry};
 use serde::Deserialize;
 
 #[derive(Debug, Deserialize)]
@@ -41,33 +43,20 @@ impl Perspective {
 
 impl Camera for Perspective {
     fn generate(&self, film: &[Vec2], _lens: &[Vec2], out: CameraRays<'_>) {
-        let origin = self.to_render.transform_point3(Vec3::ZERO);
-        for (i, p) in film.iter().enumerate() {
-            let local = self.pinhole.plane_point(*p).extend(1.0);
-            out.origins[i] = origin;
-            out.directions[i] = self.to_render.transform_vector3(local).normalize();
-            out.weights[i] = 1.0;
-        }
+        central_rays(&self.to_render, film, out, |p| {
+            self.pinhole.plane_point(p).extend(1.0)
+        });
     }
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Camera>(
-        ModuleInfo {
-            type_name: "perspective",
-            summary: "Ideal pinhole camera. Pose from the camera's `look_at` or `transform`.",
-            params: DOCS,
-        },
-        |params: &Params, ctx: &mut BuildContext<'_>| {
-            let p: PerspectiveParams = params.parse()?;
-            let camera = Perspective::new(
-                ctx.camera_to_render,
-                ctx.resolution.as_vec2(),
-                p.fov,
-                p.fov_axis,
-            )
-            .map_err(|e| e.at(params))?;
-            Ok(Box::new(camera) as Box<dyn Camera>)
+    crate::register_camera(
+        registry,
+        "perspective",
+        "Ideal pinhole camera. Pose from the camera's `look_at` or `transform`.",
+        DOCS,
+        |p: PerspectiveParams, to_render, resolution| {
+            Perspective::new(to_render, resolution, p.fov, p.fov_axis)
         },
     );
 }
@@ -75,6 +64,8 @@ pub(crate) fn register(registry: &mut Registry) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use radiant_core::Params;
+    use radiant_core::glam::Vec3;
     use radiant_core::params::check_param_docs;
 
     #[test]

@@ -1,13 +1,13 @@
-//! What the cameras share: the film-to-camera-plane mapping, the field of
-//! view parameters and their validation.
+//! What the cameras share: the film-to-camera-plane mapping, the rays of
+//! central projections, the field of view parameters and their validation.
 //!
 //! Camera space follows Mitsuba: +z forward, +y up, +x left. Film positions
 //! are raster pixels with the origin at the image's top-left corner and +y
 //! down. Every camera maps a film position to *normalised device
 //! coordinates* in [−1, 1]² (+x right, +y up) first.
 
-use radiant_core::glam::Vec2;
-use radiant_core::{ParamDoc, ParamError, Params};
+use radiant_core::glam::{Mat4, Vec2, Vec3};
+use radiant_core::{CameraRays, ParamDoc, ParamError, Params};
 use serde::Deserialize;
 use std::fmt;
 
@@ -119,6 +119,24 @@ impl Pinhole {
         let ndc = self.raster.ndc(p);
         // Camera space +x is left, NDC +x is right.
         Vec2::new(-ndc.x * self.tan_half.x, ndc.y * self.tan_half.y)
+    }
+}
+
+/// Writes the rays of a central projection: from the pose's origin along
+/// the camera-space directions `direction(film[i])`, normalised after the
+/// pose, with weight 1.
+#[inline]
+pub(crate) fn central_rays(
+    to_render: &Mat4,
+    film: &[Vec2],
+    out: CameraRays<'_>,
+    direction: impl Fn(Vec2) -> Vec3,
+) {
+    let origin = to_render.transform_point3(Vec3::ZERO);
+    for (i, p) in film.iter().enumerate() {
+        out.origins[i] = origin;
+        out.directions[i] = to_render.transform_vector3(direction(*p)).normalize();
+        out.weights[i] = 1.0;
     }
 }
 

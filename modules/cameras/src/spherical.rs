@@ -8,8 +8,9 @@
 //! (φ, λ) rectangle, so rays are unweighted and the image is radiance
 //! per direction, as an environment map stores it.
 
+use crate::projection::central_rays;
 use radiant_core::glam::{Mat4, Vec2, Vec3};
-use radiant_core::{BuildContext, Camera, CameraRays, ModuleInfo, Params, Registry};
+use radiant_core::{Camera, CameraRays, Registry};
 use serde::Deserialize;
 use std::f32::consts::{PI, TAU};
 
@@ -46,30 +47,17 @@ impl Spherical {
 
 impl Camera for Spherical {
     fn generate(&self, film: &[Vec2], _lens: &[Vec2], out: CameraRays<'_>) {
-        let origin = self.to_render.transform_point3(Vec3::ZERO);
-        for (i, p) in film.iter().enumerate() {
-            out.origins[i] = origin;
-            out.directions[i] = self
-                .to_render
-                .transform_vector3(self.direction(*p))
-                .normalize();
-            out.weights[i] = 1.0;
-        }
+        central_rays(&self.to_render, film, out, |p| self.direction(p));
     }
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Camera>(
-        ModuleInfo {
-            type_name: "spherical",
-            summary: "360° equirectangular panorama (longitude along x, latitude along y). Pose from `look_at` or `transform`.",
-            params: &[],
-        },
-        |params: &Params, ctx: &mut BuildContext<'_>| {
-            let _: SphericalParams = params.parse()?;
-            Ok(Box::new(Spherical::new(ctx.camera_to_render, ctx.resolution.as_vec2()))
-                as Box<dyn Camera>)
-        },
+    crate::register_camera(
+        registry,
+        "spherical",
+        "360° equirectangular panorama (longitude along x, latitude along y). Pose from `look_at` or `transform`.",
+        &[],
+        |_: SphericalParams, to_render, resolution| Ok(Spherical::new(to_render, resolution)),
     );
 }
 

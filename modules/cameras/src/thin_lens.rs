@@ -12,9 +12,7 @@ use crate::projection::{
 };
 use radiant_core::glam::{Mat4, Vec2};
 use radiant_core::warp::square_to_disk_concentric;
-use radiant_core::{
-    BuildContext, Camera, CameraRays, Effects, ModuleInfo, ParamDoc, Params, Registry,
-};
+use radiant_core::{Camera, CameraRays, Effects, ParamDoc, Registry};
 use serde::Deserialize;
 
 #[derive(Debug, Deserialize)]
@@ -106,24 +104,20 @@ impl Camera for ThinLens {
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Camera>(
-        ModuleInfo {
-            type_name: "thin_lens",
-            summary: "Thin lens with a circular aperture (depth of field). Pose from `look_at` or `transform`.",
-            params: DOCS,
-        },
-        |params: &Params, ctx: &mut BuildContext<'_>| {
-            let p: ThinLensParams = params.parse()?;
-            let camera = ThinLens::new(
-                ctx.camera_to_render,
-                ctx.resolution.as_vec2(),
+    crate::register_camera(
+        registry,
+        "thin_lens",
+        "Thin lens with a circular aperture (depth of field). Pose from `look_at` or `transform`.",
+        DOCS,
+        |p: ThinLensParams, to_render, resolution| {
+            ThinLens::new(
+                to_render,
+                resolution,
                 p.fov,
                 p.fov_axis,
                 p.aperture_radius,
                 p.focus_distance,
             )
-            .map_err(|e| e.at(params))?;
-            Ok(Box::new(camera) as Box<dyn Camera>)
         },
     );
 }

@@ -2,11 +2,12 @@
 //! as sunlight. Its next-event samples lie outside the scene's bounding
 //! sphere, against the direction of travel.
 
+use crate::delta::sample_delta;
 use crate::params::{axis, check_colour};
 use radiant_core::glam::{DVec3, Vec2, Vec3};
 use radiant_core::{
-    BoundingSphere, Color, Effects, Light, LightSample, ModuleInfo, ParamDoc, Params, Registry,
-    Rgb, luminance,
+    BoundingSphere, BuildContext, Color, Effects, Light, LightSample, ParamDoc, ParamError, Params,
+    Registry, Rgb, luminance,
 };
 use serde::Deserialize;
 
@@ -65,14 +66,7 @@ impl Light for DirectionalLight {
 
     fn sample(&self, refs: &[Vec3], _u: &[Vec2], out: &mut [LightSample]) {
         let back = self.direction * (-2.0 * self.sphere.radius);
-        for (r, o) in refs.iter().zip(out.iter_mut()) {
-            *o = LightSample {
-                p: *r + back,
-                n: Vec3::ZERO,
-                radiance: self.irradiance,
-                pdf: 1.0,
-            };
-        }
+        sample_delta(refs, out, |r| (r + back, self.irradiance));
     }
 
     fn effects(&self) -> Effects {
@@ -80,23 +74,24 @@ impl Light for DirectionalLight {
     }
 }
 
+fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<DirectionalLight, ParamError> {
+    let p: DirectionalParams = params.parse()?;
+    check_colour(params, "irradiance", p.irradiance.0)?;
+    let direction = axis(params, ctx, DVec3::ZERO, p.direction, None)?;
+    Ok(DirectionalLight::new(
+        direction,
+        p.irradiance.0,
+        ctx.scene_sphere,
+    ))
+}
+
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Light>(
-        ModuleInfo {
-            type_name: "directional",
-            summary: "Parallel light from infinitely far away (e.g. the sun).",
-            params: DOCS,
-        },
-        |params: &Params, ctx| {
-            let p: DirectionalParams = params.parse()?;
-            check_colour(params, "irradiance", p.irradiance.0)?;
-            let direction = axis(params, ctx, DVec3::ZERO, p.direction, None)?;
-            Ok(Box::new(DirectionalLight::new(
-                direction,
-                p.irradiance.0,
-                ctx.scene_sphere,
-            )) as Box<dyn Light>)
-        },
+    crate::register_light(
+        registry,
+        "directional",
+        "Parallel light from infinitely far away (e.g. the sun).",
+        DOCS,
+        build,
     );
 }
 

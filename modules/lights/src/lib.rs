@@ -5,6 +5,7 @@
 //! (surface emitters) or leaves the scene (environment lights).
 
 mod area;
+mod delta;
 mod directional;
 mod environment;
 mod map_file;
@@ -19,7 +20,7 @@ pub use environment::EnvironmentLight;
 pub use point::PointLight;
 pub use spot::SpotLight;
 
-use radiant_core::Registry;
+use radiant_core::{BuildContext, Light, ModuleInfo, ParamDoc, ParamError, Params, Registry};
 
 /// Registers every built-in light type.
 pub fn register(registry: &mut Registry) {
@@ -28,4 +29,23 @@ pub fn register(registry: &mut Registry) {
     environment::register(registry);
     point::register(registry);
     spot::register(registry);
+}
+
+/// Registers the light type `type_name`, built from its parameters by
+/// `build`.
+fn register_light<L: Light + 'static>(
+    registry: &mut Registry,
+    type_name: &'static str,
+    summary: &'static str,
+    params: &'static [ParamDoc],
+    build: fn(&Params, &mut BuildContext<'_>) -> Result<L, ParamError>,
+) {
+    registry.register::<dyn Light>(
+        ModuleInfo {
+            type_name,
+            summary,
+            params,
+        },
+        move |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Light>),
+    );
 }

@@ -1,9 +1,11 @@
 //! The `point` light: an isotropic point source.
 
+use crate::delta::sample_delta;
 use crate::params::{check_colour, place};
 use radiant_core::glam::{DVec3, Vec2, Vec3};
 use radiant_core::{
-    Color, Effects, Light, LightSample, ModuleInfo, ParamDoc, Params, Registry, Rgb, luminance,
+    BuildContext, Color, Effects, Light, LightSample, ParamDoc, ParamError, Params, Registry, Rgb,
+    luminance,
 };
 use serde::Deserialize;
 
@@ -56,19 +58,15 @@ impl Light for PointLight {
     }
 
     fn sample(&self, refs: &[Vec3], _u: &[Vec2], out: &mut [LightSample]) {
-        for (r, o) in refs.iter().zip(out.iter_mut()) {
-            let dist2 = (self.position - *r).length_squared();
-            *o = LightSample {
-                p: self.position,
-                n: Vec3::ZERO,
-                radiance: if dist2 > 0.0 {
-                    self.intensity / dist2
-                } else {
-                    Rgb::ZERO
-                },
-                pdf: 1.0,
+        sample_delta(refs, out, |r| {
+            let dist2 = (self.position - r).length_squared();
+            let radiance = if dist2 > 0.0 {
+                self.intensity / dist2
+            } else {
+                Rgb::ZERO
             };
-        }
+            (self.position, radiance)
+        });
     }
 
     fn effects(&self) -> Effects {
@@ -76,20 +74,15 @@ impl Light for PointLight {
     }
 }
 
+fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<PointLight, ParamError> {
+    let p: PointParams = params.parse()?;
+    check_colour(params, "intensity", p.intensity.0)?;
+    let position = place(ctx, DVec3::from_array(p.position));
+    Ok(PointLight::new(position, p.intensity.0))
+}
+
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Light>(
-        ModuleInfo {
-            type_name: "point",
-            summary: "Isotropic point light.",
-            params: DOCS,
-        },
-        |params: &Params, ctx| {
-            let p: PointParams = params.parse()?;
-            check_colour(params, "intensity", p.intensity.0)?;
-            let position = place(ctx, DVec3::from_array(p.position));
-            Ok(Box::new(PointLight::new(position, p.intensity.0)) as Box<dyn Light>)
-        },
-    );
+    crate::register_light(registry, "point", "Isotropic point light.", DOCS, build);
 }
 
 #[cfg(test)]

@@ -2,10 +2,11 @@
 //! falloff (full intensity inside `beam_width`, then linear in angle down
 //! to zero at `cutoff_angle`).
 
+use crate::delta::sample_delta;
 use crate::params::{axis, check_colour, place};
 use radiant_core::glam::{DVec3, Vec2, Vec3};
 use radiant_core::{
-    Color, Effects, Light, LightSample, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb,
+    BuildContext, Color, Effects, Light, LightSample, ParamDoc, ParamError, Params, Registry, Rgb,
     luminance,
 };
 use serde::Deserialize;
@@ -131,21 +132,16 @@ impl Light for SpotLight {
     }
 
     fn sample(&self, refs: &[Vec3], _u: &[Vec2], out: &mut [LightSample]) {
-        for (r, o) in refs.iter().zip(out.iter_mut()) {
-            let d = *r - self.position;
+        sample_delta(refs, out, |r| {
+            let d = r - self.position;
             let dist2 = d.length_squared();
             let radiance = if dist2 > 0.0 {
                 self.intensity * (self.falloff(self.axis.dot(d) / dist2.sqrt()) / dist2)
             } else {
                 Rgb::ZERO
             };
-            *o = LightSample {
-                p: self.position,
-                n: Vec3::ZERO,
-                radiance,
-                pdf: 1.0,
-            };
-        }
+            (self.position, radiance)
+        });
     }
 
     fn effects(&self) -> Effects {
@@ -153,42 +149,43 @@ impl Light for SpotLight {
     }
 }
 
+fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<SpotLight, ParamError> {
+    let p: SpotParams = params.parse()?;
+    check_colour(params, "intensity", p.intensity.0)?;
+    let cutoff = p.cutoff_angle;
+    if !(cutoff > 0.0 && cutoff <= 180.0) {
+        return Err(ParamError {
+            message: format!("`cutoff_angle` must be in (0, 180] degrees, found {cutoff}"),
+            location: params.location_of("cutoff_angle"),
+        });
+    }
+    let beam = p.beam_width.unwrap_or(0.75 * cutoff);
+    if !(0.0..=cutoff).contains(&beam) {
+        return Err(ParamError {
+            message: format!(
+                "`beam_width` must be in [0, cutoff_angle = {cutoff}] degrees, found {beam}"
+            ),
+            location: params.location_of("beam_width"),
+        });
+    }
+    let position = DVec3::from_array(p.position);
+    let axis = axis(params, ctx, position, p.direction, p.target)?;
+    Ok(SpotLight::new(
+        place(ctx, position),
+        axis,
+        p.intensity.0,
+        cutoff.to_radians(),
+        beam.to_radians(),
+    ))
+}
+
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Light>(
-        ModuleInfo {
-            type_name: "spot",
-            summary: "Point light emitting into a cone, with Mitsuba 3's linear angular falloff.",
-            params: DOCS,
-        },
-        |params: &Params, ctx| {
-            let p: SpotParams = params.parse()?;
-            check_colour(params, "intensity", p.intensity.0)?;
-            let cutoff = p.cutoff_angle;
-            if !(cutoff > 0.0 && cutoff <= 180.0) {
-                return Err(ParamError {
-                    message: format!("`cutoff_angle` must be in (0, 180] degrees, found {cutoff}"),
-                    location: params.location_of("cutoff_angle"),
-                });
-            }
-            let beam = p.beam_width.unwrap_or(0.75 * cutoff);
-            if !(0.0..=cutoff).contains(&beam) {
-                return Err(ParamError {
-                    message: format!(
-                        "`beam_width` must be in [0, cutoff_angle = {cutoff}] degrees, found {beam}"
-                    ),
-                    location: params.location_of("beam_width"),
-                });
-            }
-            let position = DVec3::from_array(p.position);
-            let axis = axis(params, ctx, position, p.direction, p.target)?;
-            Ok(Box::new(SpotLight::new(
-                place(ctx, position),
-                axis,
-                p.intensity.0,
-                cutoff.to_radians(),
-                beam.to_radians(),
-            )) as Box<dyn Light>)
-        },
+    crate::register_light(
+        registry,
+        "spot",
+        "Point light emitting into a cone, with Mitsuba 3's linear angular falloff.",
+        DOCS,
+        build,
     );
 }
 

@@ -9,12 +9,11 @@
 //! stratification, makes every sample uniformly distributed (unbiased) and
 //! decorrelates pixels and dimensions.
 
+use crate::pointwise::{Pointwise, pointwise_sampler};
 use crate::scramble::permute;
 use crate::seed::fold;
-use radiant_core::glam::Vec2;
 use radiant_core::hash::{hash_u32, hash4};
-use radiant_core::{ModuleInfo, Params, Registry, SampleId, Sampler};
-use serde::Deserialize;
+use radiant_core::{Registry, SampleId};
 
 /// Number of distinct prime bases.
 const BASES: usize = 128;
@@ -55,9 +54,11 @@ impl Halton {
     pub fn new(seed: u64) -> Self {
         Self { seed: fold(seed) }
     }
+}
 
+impl Pointwise for Halton {
     #[inline]
-    fn value(&self, id: SampleId, dim: u32) -> f32 {
+    fn value_1d(&self, id: SampleId, dim: u32) -> f32 {
         let base = PRIMES[dim as usize % BASES];
         let key = hash4(self.seed, id.pixel, dim, 0x6a09_e667);
         owen_radical_inverse(id.index, base, key)
@@ -81,35 +82,14 @@ fn owen_radical_inverse(mut index: u32, base: u32, key: u32) -> f32 {
     (sum as f32).min(1.0 - f32::EPSILON / 2.0)
 }
 
-impl Sampler for Halton {
-    fn fill_2d(&self, ids: &[SampleId], dim: u32, out: &mut [Vec2]) {
-        for (id, o) in ids.iter().zip(out.iter_mut()) {
-            *o = Vec2::new(self.value(*id, dim), self.value(*id, dim + 1));
-        }
-    }
-
-    fn fill_1d(&self, ids: &[SampleId], dim: u32, out: &mut [f32]) {
-        for (id, o) in ids.iter().zip(out.iter_mut()) {
-            *o = self.value(*id, dim);
-        }
-    }
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct HaltonParams {}
+pointwise_sampler!(Halton);
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Sampler>(
-        ModuleInfo {
-            type_name: "halton",
-            summary: "Owen-scrambled Halton sequence over each pixel's samples (dimension d in the d-th prime base).",
-            params: &[],
-        },
-        |params: &Params, ctx| {
-            let _: HaltonParams = params.parse()?;
-            Ok(Box::new(Halton::new(ctx.seed)) as Box<dyn Sampler>)
-        },
+    crate::register_sampler(
+        registry,
+        "halton",
+        "Owen-scrambled Halton sequence over each pixel's samples (dimension d in the d-th prime base).",
+        |ctx| Halton::new(ctx.seed),
     );
 }
 

@@ -11,12 +11,12 @@
 //! pair keeps the full 2D stratification. Sample counts that are powers of
 //! two are best.
 
+use crate::pointwise::{Pointwise, pointwise_sampler};
 use crate::scramble::nested_uniform_scramble;
 use crate::seed::fold;
 use radiant_core::glam::Vec2;
 use radiant_core::hash::{hash_u32, hash4, unit_float};
-use radiant_core::{ModuleInfo, Params, Registry, SampleId, Sampler};
-use serde::Deserialize;
+use radiant_core::{Registry, SampleId};
 
 /// Direction numbers of the second Sobol dimension: v₀ = 2³¹,
 /// vᵢ = vᵢ₋₁ ⊕ (vᵢ₋₁ ≫ 1) (the first dimension is the bit reversal).
@@ -59,9 +59,11 @@ impl Sobol {
     pub fn new(seed: u64) -> Self {
         Self { seed: fold(seed) }
     }
+}
 
+impl Pointwise for Sobol {
     #[inline]
-    fn point_2d(&self, id: SampleId, dim: u32) -> Vec2 {
+    fn value_2d(&self, id: SampleId, dim: u32) -> Vec2 {
         let key = hash4(self.seed, id.pixel, dim, 0x3c6e_f372);
         let i = nested_uniform_scramble(id.index, key);
         let x = nested_uniform_scramble(i.reverse_bits(), hash_u32(key ^ 0x1));
@@ -70,48 +72,28 @@ impl Sobol {
     }
 
     #[inline]
-    fn point_1d(&self, id: SampleId, dim: u32) -> f32 {
+    fn value_1d(&self, id: SampleId, dim: u32) -> f32 {
         let key = hash4(self.seed, id.pixel, dim, 0xa54f_f53a);
         let i = nested_uniform_scramble(id.index, key);
         unit_float(nested_uniform_scramble(i.reverse_bits(), hash_u32(key)))
     }
 }
 
-impl Sampler for Sobol {
-    fn fill_2d(&self, ids: &[SampleId], dim: u32, out: &mut [Vec2]) {
-        for (id, o) in ids.iter().zip(out.iter_mut()) {
-            *o = self.point_2d(*id, dim);
-        }
-    }
-
-    fn fill_1d(&self, ids: &[SampleId], dim: u32, out: &mut [f32]) {
-        for (id, o) in ids.iter().zip(out.iter_mut()) {
-            *o = self.point_1d(*id, dim);
-        }
-    }
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SobolParams {}
+pointwise_sampler!(Sobol);
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Sampler>(
-        ModuleInfo {
-            type_name: "sobol",
-            summary: "Owen-scrambled Sobol points, shuffled per dimension pair (Burley 2020); best with power-of-two spp.",
-            params: &[],
-        },
-        |params: &Params, ctx| {
-            let _: SobolParams = params.parse()?;
-            Ok(Box::new(Sobol::new(ctx.seed)) as Box<dyn Sampler>)
-        },
+    crate::register_sampler(
+        registry,
+        "sobol",
+        "Owen-scrambled Sobol points, shuffled per dimension pair (Burley 2020); best with power-of-two spp.",
+        |ctx| Sobol::new(ctx.seed),
     );
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use radiant_core::Sampler;
 
     #[test]
     fn second_dimension_matches_the_sobol_sequence() {

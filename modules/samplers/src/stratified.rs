@@ -10,12 +10,12 @@
 //! stateless and dimensions are independent of each other. Sample indices
 //! beyond N start a fresh, independently shuffled pattern.
 
+use crate::pointwise::{Pointwise, pointwise_sampler};
 use crate::scramble::permute;
 use crate::seed::fold;
 use radiant_core::glam::Vec2;
 use radiant_core::hash::{hash_u32, hash4, unit_float};
-use radiant_core::{ModuleInfo, Params, Registry, SampleId, Sampler};
-use serde::Deserialize;
+use radiant_core::{Registry, SampleId};
 
 /// Jittered stratified sampling over `spp` samples per pixel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -48,7 +48,9 @@ impl Stratified {
         let key = hash4(self.seed, id.pixel, dim, round);
         (key, permute(id.index % self.spp, self.spp, key))
     }
+}
 
+impl Pointwise for Stratified {
     #[inline]
     fn value_1d(&self, id: SampleId, dim: u32) -> f32 {
         let (key, s) = self.key(id, dim);
@@ -83,41 +85,21 @@ impl Stratified {
 /// The largest f32 below 1.
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
-impl Sampler for Stratified {
-    fn fill_2d(&self, ids: &[SampleId], dim: u32, out: &mut [Vec2]) {
-        for (id, o) in ids.iter().zip(out.iter_mut()) {
-            *o = self.value_2d(*id, dim);
-        }
-    }
-
-    fn fill_1d(&self, ids: &[SampleId], dim: u32, out: &mut [f32]) {
-        for (id, o) in ids.iter().zip(out.iter_mut()) {
-            *o = self.value_1d(*id, dim);
-        }
-    }
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct StratifiedParams {}
+pointwise_sampler!(Stratified);
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Sampler>(
-        ModuleInfo {
-            type_name: "stratified",
-            summary: "Jittered stratified samples over the pixel's spp (multi-jittered in 2D).",
-            params: &[],
-        },
-        |params: &Params, ctx| {
-            let _: StratifiedParams = params.parse()?;
-            Ok(Box::new(Stratified::new(ctx.seed, ctx.spp)) as Box<dyn Sampler>)
-        },
+    crate::register_sampler(
+        registry,
+        "stratified",
+        "Jittered stratified samples over the pixel's spp (multi-jittered in 2D).",
+        |ctx| Stratified::new(ctx.seed, ctx.spp),
     );
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use radiant_core::Sampler;
 
     fn ids(pixel: u32, n: u32) -> Vec<SampleId> {
         (0..n).map(|index| SampleId { pixel, index }).collect()

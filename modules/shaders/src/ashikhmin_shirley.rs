@@ -10,14 +10,12 @@
 //! diffuse one by the cosine.
 
 use crate::fresnel::schlick;
-use crate::inputs::{checked, scalar, texture_effects};
+use crate::half_vector::{HalfVectorLobes, HalfVectorShader, specular_probability};
+use crate::inputs::{checked, fraction, scalar};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
-use radiant_core::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
-use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamDoc, ParamError, Params,
-    Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput, luminance,
-};
+use radiant_core::warp::cosine_hemisphere_pdf;
+use radiant_core::{BuildContext, ParamDoc, ParamError, Params, Registry, Rgb, TextureInput};
 use serde::Deserialize;
 use std::f32::consts::{FRAC_PI_2, PI};
 
@@ -75,14 +73,7 @@ const DOCS: &[ParamDoc] = &[
 
 const MAX_EXPONENT: f32 = 1e5;
 
-struct AshikhminShirley {
-    diffuse: TextureId,
-    specular: TextureId,
-    nu: TextureId,
-    nv: TextureId,
-    effects: Effects,
-}
-
+/// Per-point parameters.
 #[derive(Clone, Copy)]
 struct Lobes {
     rd: Rgb,
@@ -92,20 +83,6 @@ struct Lobes {
 }
 
 impl Lobes {
-    fn new(rd: Rgb, rs: Rgb, nu: Rgb, nv: Rgb) -> Self {
-        Self {
-            rd,
-            rs,
-            nu: scalar(nu).clamp(0.0, MAX_EXPONENT),
-            nv: scalar(nv).clamp(0.0, MAX_EXPONENT),
-        }
-    }
-
-    fn specular_probability(&self) -> f32 {
-        let (s, d) = (luminance(self.rs), luminance(self.rd));
-        if s + d > 0.0 { s / (s + d) } else { 0.5 }
-    }
-
     /// The exponent nu cos²φh + nv sin²φh.
     fn exponent(&self, h: Vec3) -> f32 {
         let r2 = h.x * h.x + h.y * h.y;
@@ -122,6 +99,21 @@ impl Lobes {
             return 0.0;
         }
         ((self.nu + 1.0) * (self.nv + 1.0)).sqrt() / (2.0 * PI) * h.z.powf(self.exponent(h))
+    }
+}
+
+impl HalfVectorLobes for Lobes {
+    fn new(rd: Rgb, rs: Rgb, nu: Rgb, nv: Rgb) -> Self {
+        Self {
+            rd,
+            rs,
+            nu: scalar(nu).clamp(0.0, MAX_EXPONENT),
+            nv: scalar(nv).clamp(0.0, MAX_EXPONENT),
+        }
+    }
+
+    fn specular_probability(&self) -> f32 {
+        specular_probability(self.rd, self.rs)
     }
 
     fn sample_half(&self, u: Vec2) -> Vec3 {
@@ -172,94 +164,25 @@ impl Lobes {
     }
 }
 
-impl Shader for AshikhminShirley {
-    fn sample(
-        &self,
-        ctx: &mut ShadeContext<'_>,
-        surface: SurfaceBatch<'_>,
-        u: &[Vec3],
-        out: &mut [BsdfSample],
-    ) {
-        let [rd, rs, nu, nv] =
-            ctx.lookup([self.diffuse, self.specular, self.nu, self.nv], surface.uv);
-        for (i, o) in out.iter_mut().enumerate() {
-            let wo = surface.wo[i];
-            *o = BsdfSample::default();
-            if wo.z <= 0.0 {
-                continue;
-            }
-            let lobes = Lobes::new(rd[i], rs[i], nu[i], nv[i]);
-            let u2 = Vec2::new(u[i].y, u[i].z);
-            let wi = if u[i].x < lobes.specular_probability() {
-                let h = lobes.sample_half(u2);
-                2.0 * wo.dot(h) * h - wo
-            } else {
-                square_to_cosine_hemisphere(u2)
-            };
-            let (value, pdf) = lobes.eval(wo, wi);
-            if pdf > 0.0 {
-                *o = BsdfSample {
-                    wi,
-                    weight: value / pdf,
-                    pdf,
-                    delta: false,
-                    eta: 1.0,
-                };
-            }
-        }
-    }
-
-    fn eval(
-        &self,
-        ctx: &mut ShadeContext<'_>,
-        surface: SurfaceBatch<'_>,
-        wi: &[Vec3],
-        out: &mut [BsdfEval],
-    ) {
-        let [rd, rs, nu, nv] =
-            ctx.lookup([self.diffuse, self.specular, self.nu, self.nv], surface.uv);
-        for (i, o) in out.iter_mut().enumerate() {
-            let (value, pdf) = Lobes::new(rd[i], rs[i], nu[i], nv[i]).eval(surface.wo[i], wi[i]);
-            *o = BsdfEval { value, pdf };
-        }
-    }
-
-    fn effects(&self) -> Effects {
-        self.effects
-    }
-}
-
-fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<AshikhminShirley, ParamError> {
+fn build(
+    params: &Params,
+    ctx: &mut BuildContext<'_>,
+) -> Result<HalfVectorShader<Lobes>, ParamError> {
     let p: AsParams = params.parse()?;
-    let diffuse = checked(ctx, &p.diffuse_reflectance, "diffuse_reflectance", 0.0, 1.0)?;
-    let specular = checked(
-        ctx,
-        &p.specular_reflectance,
-        "specular_reflectance",
-        0.0,
-        1.0,
-    )?;
+    let diffuse = fraction(ctx, &p.diffuse_reflectance, "diffuse_reflectance")?;
+    let specular = fraction(ctx, &p.specular_reflectance, "specular_reflectance")?;
     let nu = checked(ctx, &p.exponent_u, "exponent_u", 0.0, MAX_EXPONENT)?;
     let nv = checked(ctx, &p.exponent_v, "exponent_v", 0.0, MAX_EXPONENT)?;
-    Ok(AshikhminShirley {
-        diffuse,
-        specular,
-        nu,
-        nv,
-        effects: Effects::SMOOTH_LOBES
-            | Effects::GLOSSY
-            | texture_effects(ctx, &[diffuse, specular, nu, nv]),
-    })
+    Ok(HalfVectorShader::new(ctx, [diffuse, specular, nu, nv]))
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "ashikhmin_shirley",
-            summary: "Ashikhmin–Shirley anisotropic Phong glossy lobe with its energy-coupled diffuse term.",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "ashikhmin_shirley",
+        "Ashikhmin–Shirley anisotropic Phong glossy lobe with its energy-coupled diffuse term.",
+        DOCS,
+        build,
     );
 }
 

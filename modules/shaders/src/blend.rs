@@ -8,12 +8,12 @@
 //! keeps its component's weight, which is unbiased for the mix (a delta
 //! lobe of one component is not evaluated through the other).
 
-use crate::inputs::{checked, scalar, texture_effects};
+use crate::inputs::{fraction, scalar, texture_effects};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamDoc, ParamError, Params,
-    Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 use serde::de::IgnoredAny;
@@ -205,7 +205,7 @@ impl Shader for Blend {
 
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Blend, ParamError> {
     let p: BlendParams = params.parse()?;
-    let weight = checked(ctx, &p.weight, "weight", 0.0, 1.0)?;
+    let weight = fraction(ctx, &p.weight, "weight")?;
     let list = params
         .node()
         .as_mapping()
@@ -228,13 +228,12 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Blend, ParamErro
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "blend",
-            summary: "Mix of two materials by a weight texture.",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "blend",
+        "Mix of two materials by a weight texture.",
+        DOCS,
+        build,
     );
 }
 

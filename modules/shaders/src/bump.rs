@@ -5,12 +5,12 @@
 //! are taken along the shading frame's tangents at unit scale).
 
 use crate::inputs::scalar;
-use crate::perturb;
+use crate::perturb::{self, NormalSource, Perturbed};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamDoc, ParamError, Params,
-    Registry, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BuildContext, ParamDoc, ParamError, Params, Registry, ShadeContext, SurfaceBatch, TextureId,
+    TextureInput,
 };
 use serde::Deserialize;
 use serde::de::IgnoredAny;
@@ -54,15 +54,15 @@ const DOCS: &[ParamDoc] = &[
 /// Finite-difference step in (u, v).
 pub const STEP: f32 = 1.0 / 1024.0;
 
-struct Bump {
+/// Normals from the gradient of a height texture.
+struct BumpNormals {
     height: TextureId,
     scale: f32,
-    nested: Box<dyn Shader>,
-    effects: Effects,
 }
 
-impl Bump {
-    fn normals(&self, ctx: &mut ShadeContext<'_>, uv: &[Vec2]) -> Vec<Vec3> {
+impl NormalSource for BumpNormals {
+    fn normals(&self, ctx: &mut ShadeContext<'_>, surface: SurfaceBatch<'_>) -> Vec<Vec3> {
+        let uv = surface.uv;
         let n = uv.len();
         let mut shifted = ctx.take::<Vec2>(4 * n);
         for (i, uv) in uv.iter().enumerate() {
@@ -84,37 +84,10 @@ impl Bump {
     }
 }
 
-impl Shader for Bump {
-    fn sample(
-        &self,
-        ctx: &mut ShadeContext<'_>,
-        surface: SurfaceBatch<'_>,
-        u: &[Vec3],
-        out: &mut [BsdfSample],
-    ) {
-        let normals = self.normals(ctx, surface.uv);
-        perturb::sample(&*self.nested, ctx, surface, &normals, u, out);
-        ctx.recycle(normals);
-    }
-
-    fn eval(
-        &self,
-        ctx: &mut ShadeContext<'_>,
-        surface: SurfaceBatch<'_>,
-        wi: &[Vec3],
-        out: &mut [BsdfEval],
-    ) {
-        let normals = self.normals(ctx, surface.uv);
-        perturb::eval(&*self.nested, ctx, surface, &normals, wi, out);
-        ctx.recycle(normals);
-    }
-
-    fn effects(&self) -> Effects {
-        self.effects
-    }
-}
-
-fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Bump, ParamError> {
+fn build(
+    params: &Params,
+    ctx: &mut BuildContext<'_>,
+) -> Result<Perturbed<BumpNormals>, ParamError> {
     let p: BumpParams = params.parse()?;
     if !p.scale.is_finite() {
         return Err(ParamError {
@@ -123,24 +96,20 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Bump, ParamError
         });
     }
     let height = ctx.texture(&p.height)?;
-    let nested = ctx.material(params, "material")?;
-    let effects = nested.effects() | ctx.textures.effects(height);
-    Ok(Bump {
+    let source = BumpNormals {
         height,
         scale: p.scale,
-        nested,
-        effects,
-    })
+    };
+    Perturbed::new(source, height, params, ctx)
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "bump",
-            summary: "Wraps a material, tilting its shading normal by the gradient of a height texture.",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "bump",
+        "Wraps a material, tilting its shading normal by the gradient of a height texture.",
+        DOCS,
+        build,
     );
 }
 

@@ -5,13 +5,14 @@
 //! colour. Mitsuba 3's `conductor` and `roughconductor` in one module.
 
 use crate::fresnel;
-use crate::inputs::{ROUGHNESS_DOCS, Roughness, checked, roughness, scalar, texture_effects};
+use crate::inputs::{ROUGHNESS_DOCS, Roughness, fraction, roughness, scalar, texture_effects};
+use crate::lobes::{mirror_sample, reflection_sample};
 use crate::metals;
 use crate::microfacet::{Ggx, reflect};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, Color, Effects, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb,
+    BsdfEval, BsdfSample, Color, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
     ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
@@ -106,13 +107,7 @@ impl Shader for Conductor {
                 continue;
             }
             if self.rough.smooth {
-                *o = BsdfSample {
-                    wi: Vec3::new(-wo.x, -wo.y, wo.z),
-                    weight: self.fresnel.at(wo.z) * spec[i],
-                    pdf: 1.0,
-                    delta: true,
-                    eta: 1.0,
-                };
+                *o = mirror_sample(wo, self.fresnel.at(wo.z) * spec[i], 1.0);
                 continue;
             }
             let ggx = Ggx::new(scalar(au[i]), scalar(av[i]));
@@ -122,13 +117,11 @@ impl Shader for Conductor {
             if wi.z <= 0.0 || !(pdf > 0.0 && pdf.is_finite()) {
                 continue;
             }
-            *o = BsdfSample {
+            *o = reflection_sample(
                 wi,
-                weight: self.fresnel.at(wo.dot(m)) * spec[i] * ggx.g1(wi, m),
+                self.fresnel.at(wo.dot(m)) * spec[i] * ggx.g1(wi, m),
                 pdf,
-                delta: false,
-                eta: 1.0,
-            };
+            );
         }
     }
 
@@ -218,13 +211,7 @@ fn build(
             ));
         }
     };
-    let specular = checked(
-        ctx,
-        &p.specular_reflectance,
-        "specular_reflectance",
-        0.0,
-        1.0,
-    )?;
+    let specular = fraction(ctx, &p.specular_reflectance, "specular_reflectance")?;
     let rough = roughness(&p.alpha, &p.alpha_u, &p.alpha_v, ctx)?;
     let lobes = if rough.smooth {
         Effects::DELTA_LOBES
@@ -240,13 +227,12 @@ fn build(
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "conductor",
-            summary: "Metal: smooth mirror or rough GGX (visible-normal sampling), isotropic or anisotropic, complex-IOR presets.",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "conductor",
+        "Metal: smooth mirror or rough GGX (visible-normal sampling), isotropic or anisotropic, complex-IOR presets.",
+        DOCS,
+        build,
     );
 }
 

@@ -7,15 +7,15 @@
 
 use crate::fresnel;
 use crate::inputs::{
-    BK7, Ior, ROUGHNESS_DOCS, Roughness, checked, relative_ior, roughness, scalar, texture_effects,
+    BK7, Ior, ROUGHNESS_DOCS, Roughness, fraction, relative_ior, roughness, scalar, texture_effects,
 };
-use crate::lobes::{interface_eval, interface_sample};
+use crate::lobes::{interface_eval, interface_sample, mirror_sample};
 use crate::microfacet::Ggx;
 use radiant_core::glam::Vec3;
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamDoc, ParamError, Params,
-    Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 
@@ -106,13 +106,7 @@ impl Shader for Dielectric {
             if self.rough.smooth {
                 let f = fresnel::dielectric(wo.z, self.eta);
                 *o = if u[i].x <= f.r {
-                    BsdfSample {
-                        wi: Vec3::new(-wo.x, -wo.y, wo.z),
-                        weight: kr[i],
-                        pdf: f.r,
-                        delta: true,
-                        eta: 1.0,
-                    }
+                    mirror_sample(wo, kr[i], f.r)
                 } else {
                     BsdfSample {
                         wi: Vec3::new(-f.eta_ti * wo.x, -f.eta_ti * wo.y, f.cos_t),
@@ -181,20 +175,8 @@ impl Shader for Dielectric {
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Dielectric, ParamError> {
     let p: DielectricParams = params.parse()?;
     let eta = relative_ior(&p.int_ior, &p.ext_ior, BK7);
-    let reflectance = checked(
-        ctx,
-        &p.specular_reflectance,
-        "specular_reflectance",
-        0.0,
-        1.0,
-    )?;
-    let transmittance = checked(
-        ctx,
-        &p.specular_transmittance,
-        "specular_transmittance",
-        0.0,
-        1.0,
-    )?;
+    let reflectance = fraction(ctx, &p.specular_reflectance, "specular_reflectance")?;
+    let transmittance = fraction(ctx, &p.specular_transmittance, "specular_transmittance")?;
     let mut rough = roughness(&p.alpha, &p.alpha_u, &p.alpha_v, ctx)?;
     // An index-matched interface deflects no ray whatever its microfacets
     // (and the generalised half vector of Walter et al. vanishes): smooth.
@@ -216,13 +198,12 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Dielectric, Para
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "dielectric",
-            summary: "Glass-like interface: smooth (exact Fresnel, total internal reflection) or rough (Walter et al. 2007, GGX visible normals).",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "dielectric",
+        "Glass-like interface: smooth (exact Fresnel, total internal reflection) or rough (Walter et al. 2007, GGX visible normals).",
+        DOCS,
+        build,
     );
 }
 

@@ -1,11 +1,12 @@
 //! The `diffuse` shader: an ideal one-sided Lambertian reflector.
 
+use crate::lobes::reflection_sample;
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use radiant_core::{
-    BsdfEval, BsdfSample, Effects, ModuleInfo, ParamDoc, Params, Registry, Rgb, ShadeContext,
-    Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 use std::f32::consts::FRAC_1_PI;
@@ -59,13 +60,7 @@ impl Shader for Diffuse {
             let wi = square_to_cosine_hemisphere(Vec2::new(u.y, u.z));
             let pdf = cosine_hemisphere_pdf(wi);
             *o = if wo.z > 0.0 && pdf > 0.0 {
-                BsdfSample {
-                    wi,
-                    weight: *a,
-                    pdf,
-                    delta: false,
-                    eta: 1.0,
-                }
+                reflection_sample(wi, *a, pdf)
             } else {
                 BsdfSample::default()
             };
@@ -97,19 +92,20 @@ impl Shader for Diffuse {
     }
 }
 
+fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Diffuse, ParamError> {
+    let p: DiffuseParams = params.parse()?;
+    let reflectance = ctx.texture(&p.reflectance)?;
+    let effects = ctx.textures.effects(reflectance);
+    Ok(Diffuse::new(reflectance, effects))
+}
+
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "diffuse",
-            summary: "Ideal one-sided Lambertian reflector.",
-            params: DOCS,
-        },
-        |params: &Params, ctx| {
-            let p: DiffuseParams = params.parse()?;
-            let reflectance = ctx.texture(&p.reflectance)?;
-            let effects = ctx.textures.effects(reflectance);
-            Ok(Box::new(Diffuse::new(reflectance, effects)) as Box<dyn Shader>)
-        },
+    crate::register_shader(
+        registry,
+        "diffuse",
+        "Ideal one-sided Lambertian reflector.",
+        DOCS,
+        build,
     );
 }
 

@@ -27,6 +27,16 @@ pub(crate) fn checked(
     ctx.texture(input)
 }
 
+/// Resolves a texture-or-constant input whose constants must lie in
+/// [0, 1] (reflectances, weights, roughness).
+pub(crate) fn fraction(
+    ctx: &mut BuildContext<'_>,
+    input: &Spanned<TextureInput>,
+    name: &str,
+) -> Result<TextureId, ParamError> {
+    checked(ctx, input, name, 0.0, 1.0)
+}
+
 /// The effects of the textures `ids` (empty for constants).
 pub(crate) fn texture_effects(ctx: &BuildContext<'_>, ids: &[TextureId]) -> Effects {
     ids.iter()
@@ -103,8 +113,8 @@ impl RoughnessParams<'_> {
         };
         let smooth = matches!((&**u, &**v), (TextureInput::Value(a), TextureInput::Value(b)) if *a == Rgb::ZERO && *b == Rgb::ZERO);
         Ok(Roughness {
-            u: checked(ctx, u, "alpha", 0.0, 1.0)?,
-            v: checked(ctx, v, "alpha", 0.0, 1.0)?,
+            u: fraction(ctx, u, "alpha")?,
+            v: fraction(ctx, v, "alpha")?,
             smooth,
         })
     }

@@ -6,9 +6,10 @@
 //!
 //! Shared maths: [`microfacet`] (GGX with visible-normal sampling),
 //! `fresnel`, `lobes` (GGX reflection and the rough dielectric interface
-//! used by several shaders), `perturb` (the frame of `normal_map` and
-//! `bump`), `inputs` (parameter helpers) and `metals` (complex indices of
-//! refraction).
+//! used by several shaders), `half_vector` (the shader of `ward` and
+//! `ashikhmin_shirley`), `perturb` (the normal-perturbing wrapper of
+//! `normal_map` and `bump`), `inputs` (parameter helpers) and `metals`
+//! (complex indices of refraction).
 //!
 //! Emissive surfaces are not a shader: they are declared with an `emitter`
 //! (the `area` light) on the shape, so that next-event estimation can
@@ -22,6 +23,7 @@ mod conductor;
 mod dielectric;
 mod diffuse;
 mod fresnel;
+mod half_vector;
 mod inputs;
 mod lobes;
 mod metals;
@@ -36,7 +38,7 @@ mod ward;
 
 pub use diffuse::Diffuse;
 
-use radiant_core::Registry;
+use radiant_core::{BuildContext, ModuleInfo, ParamDoc, ParamError, Params, Registry, Shader};
 
 /// Registers every built-in shader type.
 pub fn register(registry: &mut Registry) {
@@ -52,4 +54,23 @@ pub fn register(registry: &mut Registry) {
     blend::register(registry);
     normal_map::register(registry);
     bump::register(registry);
+}
+
+/// Registers the shader type `type_name`, built from its parameters by
+/// `build`.
+fn register_shader<S: Shader + 'static>(
+    registry: &mut Registry,
+    type_name: &'static str,
+    summary: &'static str,
+    params: &'static [ParamDoc],
+    build: fn(&Params, &mut BuildContext<'_>) -> Result<S, ParamError>,
+) {
+    registry.register::<dyn Shader>(
+        ModuleInfo {
+            type_name,
+            summary,
+            params,
+        },
+        move |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    );
 }

@@ -1,4 +1,5 @@
-//! Per-point lobes shared by several shaders: GGX reflection without its
+//! Per-point lobes shared by several shaders: sample constructors for
+//! reflections, GGX reflection without its
 //! Fresnel factor, and the rough dielectric interface of Walter et al.
 //! (2007) sampled through the visible normals. Values are f·|cos θi| and
 //! densities are per unit solid angle, for directions in the local frame.
@@ -6,6 +7,32 @@
 use crate::fresnel;
 use crate::microfacet::{Ggx, reflect, refract};
 use radiant_core::glam::{Vec2, Vec3};
+use radiant_core::{BsdfSample, Rgb};
+
+/// A non-delta reflection sample (no change of medium: η = 1).
+#[inline]
+pub(crate) fn reflection_sample(wi: Vec3, weight: Rgb, pdf: f32) -> BsdfSample {
+    BsdfSample {
+        wi,
+        weight,
+        pdf,
+        delta: false,
+        eta: 1.0,
+    }
+}
+
+/// A delta reflection about the normal, wi = (−wo.x, −wo.y, wo.z), chosen
+/// with probability `pdf`.
+#[inline]
+pub(crate) fn mirror_sample(wo: Vec3, weight: Rgb, pdf: f32) -> BsdfSample {
+    BsdfSample {
+        wi: Vec3::new(-wo.x, -wo.y, wo.z),
+        weight,
+        pdf,
+        delta: true,
+        eta: 1.0,
+    }
+}
 
 /// A sampled GGX reflection, before the Fresnel factor.
 #[derive(Debug, Clone, Copy, PartialEq)]

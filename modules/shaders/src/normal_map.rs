@@ -3,12 +3,12 @@
 //! tangent-space normal as 2·c − 1, +z out of the surface). See
 //! [`crate::perturb`] for the frame and its limits.
 
-use crate::perturb;
+use crate::perturb::{self, NormalSource, Perturbed};
 use radiant_core::glam::Vec3;
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamDoc, ParamError, Params,
-    Registry, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BuildContext, ParamDoc, ParamError, Params, Registry, ShadeContext, SurfaceBatch, TextureId,
+    TextureInput,
 };
 use serde::Deserialize;
 use serde::de::IgnoredAny;
@@ -37,13 +37,12 @@ const DOCS: &[ParamDoc] = &[
     },
 ];
 
-struct NormalMap {
+/// Normals read from a texture.
+struct MapNormals {
     normals: TextureId,
-    nested: Box<dyn Shader>,
-    effects: Effects,
 }
 
-impl NormalMap {
+impl NormalSource for MapNormals {
     fn normals(&self, ctx: &mut ShadeContext<'_>, surface: SurfaceBatch<'_>) -> Vec<Vec3> {
         let mut normals = ctx.take::<Vec3>(surface.len());
         let [c] = ctx.lookup([self.normals], surface.uv);
@@ -54,56 +53,19 @@ impl NormalMap {
     }
 }
 
-impl Shader for NormalMap {
-    fn sample(
-        &self,
-        ctx: &mut ShadeContext<'_>,
-        surface: SurfaceBatch<'_>,
-        u: &[Vec3],
-        out: &mut [BsdfSample],
-    ) {
-        let normals = self.normals(ctx, surface);
-        perturb::sample(&*self.nested, ctx, surface, &normals, u, out);
-        ctx.recycle(normals);
-    }
-
-    fn eval(
-        &self,
-        ctx: &mut ShadeContext<'_>,
-        surface: SurfaceBatch<'_>,
-        wi: &[Vec3],
-        out: &mut [BsdfEval],
-    ) {
-        let normals = self.normals(ctx, surface);
-        perturb::eval(&*self.nested, ctx, surface, &normals, wi, out);
-        ctx.recycle(normals);
-    }
-
-    fn effects(&self) -> Effects {
-        self.effects
-    }
-}
-
-fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<NormalMap, ParamError> {
+fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Perturbed<MapNormals>, ParamError> {
     let p: NormalMapParams = params.parse()?;
     let normals = ctx.texture(&p.normals)?;
-    let nested = ctx.material(params, "material")?;
-    let effects = nested.effects() | ctx.textures.effects(normals);
-    Ok(NormalMap {
-        normals,
-        nested,
-        effects,
-    })
+    Perturbed::new(MapNormals { normals }, normals, params, ctx)
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "normal_map",
-            summary: "Wraps a material, replacing its shading normal by a tangent-space normal map.",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "normal_map",
+        "Wraps a material, replacing its shading normal by a tangent-space normal map.",
+        DOCS,
+        build,
     );
 }
 

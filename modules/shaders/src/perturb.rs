@@ -1,5 +1,5 @@
 //! Shading with a perturbed normal, for the `normal_map` and `bump`
-//! wrappers: each point gets a new normal n′ (in the local shading frame),
+//! wrappers ([`Perturbed`] over their [`NormalSource`]): each point gets a new normal n′ (in the local shading frame),
 //! a frame around it whose first tangent is the local x axis made
 //! orthogonal to n′ (Gram–Schmidt), and the nested material is sampled and
 //! evaluated in that frame, as Mitsuba 3's `normalmap` and `bumpmap` do.
@@ -14,7 +14,10 @@
 //! reciprocity slightly, as in Mitsuba 3.
 
 use radiant_core::glam::Vec3;
-use radiant_core::{BsdfEval, BsdfSample, Frame, ShadeContext, Shader, SurfaceBatch};
+use radiant_core::{
+    BsdfEval, BsdfSample, BuildContext, Effects, Frame, ParamError, Params, ShadeContext, Shader,
+    SurfaceBatch, TextureId,
+};
 
 /// The frame around the perturbed normal `n` (unit, local coordinates).
 #[inline]
@@ -29,73 +32,117 @@ pub(crate) fn perturbed_frame(n: Vec3) -> Frame {
     }
 }
 
-/// Samples `nested` at every point in the frame of the perturbed normal
-/// `normals[i]`.
-pub(crate) fn sample(
-    nested: &dyn Shader,
-    ctx: &mut ShadeContext<'_>,
-    surface: SurfaceBatch<'_>,
-    normals: &[Vec3],
-    u: &[Vec3],
-    out: &mut [BsdfSample],
-) {
-    let mut wo = ctx.take::<Vec3>(surface.len());
-    for i in 0..surface.len() {
-        wo[i] = perturbed_frame(normals[i]).to_local(surface.wo[i]);
-    }
-    nested.sample(
-        ctx,
-        SurfaceBatch {
-            wo: &wo,
-            uv: surface.uv,
-        },
-        u,
-        out,
-    );
-    for (i, s) in out.iter_mut().enumerate() {
-        let wi = perturbed_frame(normals[i]).to_world(s.wi);
-        if wi.z * s.wi.z <= 0.0 || s.pdf <= 0.0 {
-            *s = BsdfSample::default();
-        } else {
-            s.wi = wi;
-        }
-    }
-    ctx.recycle(wo);
+/// Where a wrapper's perturbed normals come from (a normal map, a height
+/// field).
+pub(crate) trait NormalSource: Send + Sync + 'static {
+    /// The perturbed normals of the batch's points (local frame, unit,
+    /// above the surface), in a buffer taken from `ctx` that the caller
+    /// recycles.
+    fn normals(&self, ctx: &mut ShadeContext<'_>, surface: SurfaceBatch<'_>) -> Vec<Vec3>;
 }
 
-/// Evaluates `nested` at every point in the frame of `normals[i]`.
-pub(crate) fn eval(
-    nested: &dyn Shader,
-    ctx: &mut ShadeContext<'_>,
-    surface: SurfaceBatch<'_>,
-    normals: &[Vec3],
-    wi: &[Vec3],
-    out: &mut [BsdfEval],
-) {
-    let n = surface.len();
-    let mut wo = ctx.take::<Vec3>(n);
-    let mut wi_p = ctx.take::<Vec3>(n);
-    for i in 0..n {
-        let f = perturbed_frame(normals[i]);
-        wo[i] = f.to_local(surface.wo[i]);
-        wi_p[i] = f.to_local(wi[i]);
+/// A nested material shaded around the normals of a [`NormalSource`].
+pub(crate) struct Perturbed<N> {
+    source: N,
+    nested: Box<dyn Shader>,
+    effects: Effects,
+}
+
+impl<N: NormalSource> Perturbed<N> {
+    /// Wraps the material under the `material` key of `params`, with
+    /// normals from `source`, which reads the texture `texture`.
+    pub(crate) fn new(
+        source: N,
+        texture: TextureId,
+        params: &Params,
+        ctx: &mut BuildContext<'_>,
+    ) -> Result<Self, ParamError> {
+        let nested = ctx.material(params, "material")?;
+        let effects = nested.effects() | ctx.textures.effects(texture);
+        Ok(Self {
+            source,
+            nested,
+            effects,
+        })
     }
-    nested.eval(
-        ctx,
-        SurfaceBatch {
-            wo: &wo,
-            uv: surface.uv,
-        },
-        &wi_p,
-        out,
-    );
-    for i in 0..n {
-        if wi[i].z * wi_p[i].z <= 0.0 {
-            out[i] = BsdfEval::default();
+}
+
+impl<N: NormalSource> Shader for Perturbed<N> {
+    /// Samples the nested material at every point in the frame of its
+    /// perturbed normal.
+    fn sample(
+        &self,
+        ctx: &mut ShadeContext<'_>,
+        surface: SurfaceBatch<'_>,
+        u: &[Vec3],
+        out: &mut [BsdfSample],
+    ) {
+        let normals = self.source.normals(ctx, surface);
+        let mut wo = ctx.take::<Vec3>(surface.len());
+        for i in 0..surface.len() {
+            wo[i] = perturbed_frame(normals[i]).to_local(surface.wo[i]);
         }
+        self.nested.sample(
+            ctx,
+            SurfaceBatch {
+                wo: &wo,
+                uv: surface.uv,
+            },
+            u,
+            out,
+        );
+        for (i, s) in out.iter_mut().enumerate() {
+            let wi = perturbed_frame(normals[i]).to_world(s.wi);
+            if wi.z * s.wi.z <= 0.0 || s.pdf <= 0.0 {
+                *s = BsdfSample::default();
+            } else {
+                s.wi = wi;
+            }
+        }
+        ctx.recycle(wo);
+        ctx.recycle(normals);
     }
-    ctx.recycle(wo);
-    ctx.recycle(wi_p);
+
+    /// Evaluates the nested material at every point in the frame of its
+    /// perturbed normal.
+    fn eval(
+        &self,
+        ctx: &mut ShadeContext<'_>,
+        surface: SurfaceBatch<'_>,
+        wi: &[Vec3],
+        out: &mut [BsdfEval],
+    ) {
+        let normals = self.source.normals(ctx, surface);
+        let n = surface.len();
+        let mut wo = ctx.take::<Vec3>(n);
+        let mut wi_p = ctx.take::<Vec3>(n);
+        for i in 0..n {
+            let f = perturbed_frame(normals[i]);
+            wo[i] = f.to_local(surface.wo[i]);
+            wi_p[i] = f.to_local(wi[i]);
+        }
+        self.nested.eval(
+            ctx,
+            SurfaceBatch {
+                wo: &wo,
+                uv: surface.uv,
+            },
+            &wi_p,
+            out,
+        );
+        for i in 0..n {
+            if wi[i].z * wi_p[i].z <= 0.0 {
+                out[i] = BsdfEval::default();
+            }
+        }
+        ctx.recycle(wo);
+        ctx.recycle(wi_p);
+        ctx.recycle(normals);
+    }
+
+    fn effects(&self) -> Effects {
+        self.effects
+    }
 }
 
 /// Unit normal from a tangent-space vector, falling back to +z for a

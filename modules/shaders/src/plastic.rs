@@ -7,15 +7,15 @@
 //! transmittance.
 
 use crate::fresnel;
-use crate::inputs::{Ior, checked, relative_ior, scalar, texture_effects};
-use crate::lobes::{glossy_eval, glossy_sample};
+use crate::inputs::{Ior, fraction, relative_ior, scalar, texture_effects};
+use crate::lobes::{glossy_eval, glossy_sample, mirror_sample, reflection_sample};
 use crate::microfacet::{Ggx, reflect, refract};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamDoc, ParamError, Params,
-    Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 use std::f32::consts::FRAC_1_PI;
@@ -175,13 +175,7 @@ impl Shader for Plastic {
                 match &self.ggx {
                     None => {
                         let r = fresnel::dielectric(wo.z, self.eta).r;
-                        *o = BsdfSample {
-                            wi: Vec3::new(-wo.x, -wo.y, wo.z),
-                            weight: spec[i] * (r / ps),
-                            pdf: ps,
-                            delta: true,
-                            eta: 1.0,
-                        };
+                        *o = mirror_sample(wo, spec[i] * (r / ps), ps);
                         continue;
                     }
                     Some(ggx) => match glossy_sample(ggx, wo, u2) {
@@ -194,13 +188,7 @@ impl Shader for Plastic {
             };
             let (value, pdf) = self.eval_point(albedo[i], spec[i], wo, wi);
             if pdf > 0.0 && wi.z > 0.0 {
-                *o = BsdfSample {
-                    wi,
-                    weight: value / pdf,
-                    pdf,
-                    delta: false,
-                    eta: 1.0,
-                };
+                *o = reflection_sample(wi, value / pdf, pdf);
             }
         }
     }
@@ -262,14 +250,8 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Plastic, ParamEr
             format!("`alpha` must lie in [0, 1], found {alpha}"),
         ));
     }
-    let diffuse = checked(ctx, &p.diffuse_reflectance, "diffuse_reflectance", 0.0, 1.0)?;
-    let specular = checked(
-        ctx,
-        &p.specular_reflectance,
-        "specular_reflectance",
-        0.0,
-        1.0,
-    )?;
+    let diffuse = fraction(ctx, &p.diffuse_reflectance, "diffuse_reflectance")?;
+    let specular = fraction(ctx, &p.specular_reflectance, "specular_reflectance")?;
     let d_mean = scalar(ctx.textures.mean(diffuse));
     let s_mean = scalar(ctx.textures.mean(specular));
     let specular_weight = if d_mean + s_mean > 0.0 {
@@ -316,13 +298,12 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Plastic, ParamEr
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "plastic",
-            summary: "Diffuse base under a smooth or rough (GGX) dielectric coat, as Mitsuba 3's plastic/roughplastic.",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "plastic",
+        "Diffuse base under a smooth or rough (GGX) dielectric coat, as Mitsuba 3's plastic/roughplastic.",
+        DOCS,
+        build,
     );
 }
 

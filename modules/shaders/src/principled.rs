@@ -18,15 +18,15 @@
 //! an albedo estimate, and the returned density is that of the whole mix.
 
 use crate::fresnel::schlick;
-use crate::inputs::{checked, scalar, texture_effects};
+use crate::inputs::{fraction, scalar, texture_effects};
 use crate::lobes::{glossy_eval, glossy_sample, interface_eval, interface_sample};
 use crate::microfacet::Ggx;
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamDoc, ParamError, Params,
-    Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput, luminance,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput, luminance,
 };
 use serde::Deserialize;
 use std::f32::consts::PI;
@@ -273,11 +273,11 @@ impl Shader for Principled {
 
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Principled, ParamError> {
     let p: PrincipledParams = params.parse()?;
-    let base = checked(ctx, &p.base_color, "base_color", 0.0, 1.0)?;
-    let metallic = checked(ctx, &p.metallic, "metallic", 0.0, 1.0)?;
-    let roughness = checked(ctx, &p.roughness, "roughness", 0.0, 1.0)?;
-    let specular = checked(ctx, &p.specular, "specular", 0.0, 1.0)?;
-    let transmission = checked(ctx, &p.transmission, "transmission", 0.0, 1.0)?;
+    let base = fraction(ctx, &p.base_color, "base_color")?;
+    let metallic = fraction(ctx, &p.metallic, "metallic")?;
+    let roughness = fraction(ctx, &p.roughness, "roughness")?;
+    let specular = fraction(ctx, &p.specular, "specular")?;
+    let transmission = fraction(ctx, &p.transmission, "transmission")?;
     let transmits = !matches!(&*p.transmission, TextureInput::Value(v) if *v == Rgb::ZERO);
     let mut effects = Effects::SMOOTH_LOBES
         | Effects::GLOSSY
@@ -296,13 +296,12 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Principled, Para
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "principled",
-            summary: "Metalness workflow: GGX reflection, coupled diffuse and rough transmission mixed by metalness and transmission.",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "principled",
+        "Metalness workflow: GGX reflection, coupled diffuse and rough transmission mixed by metalness and transmission.",
+        DOCS,
+        build,
     );
 }
 

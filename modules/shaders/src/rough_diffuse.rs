@@ -3,13 +3,14 @@
 //! as in Mitsuba 3's `roughdiffuse` (after Oren and Nayar 1994); sampled by
 //! the cosine-weighted hemisphere.
 
-use crate::inputs::{checked, scalar, texture_effects};
+use crate::inputs::{fraction, scalar, texture_effects};
+use crate::lobes::reflection_sample;
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamDoc, ParamError, Params,
-    Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 use std::f32::consts::{FRAC_1_PI, SQRT_2};
@@ -113,13 +114,7 @@ impl Shader for RoughDiffuse {
             let wi = square_to_cosine_hemisphere(Vec2::new(u[i].y, u[i].z));
             let pdf = cosine_hemisphere_pdf(wi);
             *o = if wo.z > 0.0 && pdf > 0.0 {
-                BsdfSample {
-                    wi,
-                    weight: oren_nayar(rho[i], scalar(alpha[i]), wo, wi) / pdf,
-                    pdf,
-                    delta: false,
-                    eta: 1.0,
-                }
+                reflection_sample(wi, oren_nayar(rho[i], scalar(alpha[i]), wo, wi) / pdf, pdf)
             } else {
                 BsdfSample::default()
             };
@@ -154,8 +149,8 @@ impl Shader for RoughDiffuse {
 
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<RoughDiffuse, ParamError> {
     let p: RoughDiffuseParams = params.parse()?;
-    let reflectance = checked(ctx, &p.reflectance, "reflectance", 0.0, 1.0)?;
-    let alpha = checked(ctx, &p.alpha, "alpha", 0.0, 1.0)?;
+    let reflectance = fraction(ctx, &p.reflectance, "reflectance")?;
+    let alpha = fraction(ctx, &p.alpha, "alpha")?;
     Ok(RoughDiffuse {
         reflectance,
         alpha,
@@ -164,13 +159,12 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<RoughDiffuse, Pa
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "rough_diffuse",
-            summary: "Oren–Nayar rough diffuse reflector (full model with interreflection, as Mitsuba 3).",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "rough_diffuse",
+        "Oren–Nayar rough diffuse reflector (full model with interreflection, as Mitsuba 3).",
+        DOCS,
+        build,
     );
 }
 

@@ -5,12 +5,13 @@
 
 use crate::dielectric::{EXT_IOR_DOC, INT_IOR_DOC};
 use crate::fresnel;
-use crate::inputs::{BK7, Ior, checked, relative_ior, texture_effects};
+use crate::inputs::{BK7, Ior, fraction, relative_ior, texture_effects};
+use crate::lobes::mirror_sample;
 use radiant_core::glam::Vec3;
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamDoc, ParamError, Params,
-    Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 
@@ -81,13 +82,7 @@ impl Shader for ThinDielectric {
             }
             let r = slab_reflectance(fresnel::dielectric(wo.z.abs(), self.eta).r);
             *o = if u[i].x <= r {
-                BsdfSample {
-                    wi: Vec3::new(-wo.x, -wo.y, wo.z),
-                    weight: kr[i],
-                    pdf: r,
-                    delta: true,
-                    eta: 1.0,
-                }
+                mirror_sample(wo, kr[i], r)
             } else {
                 BsdfSample {
                     wi: -wo,
@@ -118,20 +113,8 @@ impl Shader for ThinDielectric {
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<ThinDielectric, ParamError> {
     let p: ThinParams = params.parse()?;
     let eta = relative_ior(&p.int_ior, &p.ext_ior, BK7);
-    let reflectance = checked(
-        ctx,
-        &p.specular_reflectance,
-        "specular_reflectance",
-        0.0,
-        1.0,
-    )?;
-    let transmittance = checked(
-        ctx,
-        &p.specular_transmittance,
-        "specular_transmittance",
-        0.0,
-        1.0,
-    )?;
+    let reflectance = fraction(ctx, &p.specular_reflectance, "specular_reflectance")?;
+    let transmittance = fraction(ctx, &p.specular_transmittance, "specular_transmittance")?;
     Ok(ThinDielectric {
         eta,
         reflectance,
@@ -143,13 +126,12 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<ThinDielectric, 
 }
 
 pub(crate) fn register(registry: &mut Registry) {
-    registry.register::<dyn Shader>(
-        ModuleInfo {
-            type_name: "thin_dielectric",
-            summary: "Thin dielectric slab: internal reflections summed, no refraction (both lobes delta).",
-            params: DOCS,
-        },
-        |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Shader>),
+    crate::register_shader(
+        registry,
+        "thin_dielectric",
+        "Thin dielectric slab: internal reflections summed, no refraction (both lobes delta).",
+        DOCS,
+        build,
     );
 }
 

@@ -1,0 +1,58 @@
+//! The batch fill every built-in sampler shares.
+//!
+//! Each built-in sampler computes a sample's value at a dimension on its own,
+//! from (seed, pixel, index, dimension); [`Pointwise`] is that per-value
+//! function and [`pointwise_sampler!`] writes the [`Sampler`] batch loops
+//! over it once, monomorphised per sampler (no dynamic dispatch per value).
+//!
+//! [`Sampler`]: radiant_core::Sampler
+
+use radiant_core::SampleId;
+use radiant_core::glam::Vec2;
+
+/// A sampler whose values are computed one sample at a time.
+pub(crate) trait Pointwise {
+    /// Dimension `dim` of sample `id`, in [0, 1).
+    fn value_1d(&self, id: SampleId, dim: u32) -> f32;
+
+    /// Dimensions `dim` and `dim + 1` of sample `id`, each in [0, 1); by
+    /// default two independent 1D values.
+    #[inline]
+    fn value_2d(&self, id: SampleId, dim: u32) -> Vec2 {
+        Vec2::new(self.value_1d(id, dim), self.value_1d(id, dim + 1))
+    }
+}
+
+/// Writes `value(ids[i])` into `out[i]`.
+#[inline]
+pub(crate) fn fill<T>(ids: &[SampleId], out: &mut [T], value: impl Fn(SampleId) -> T) {
+    for (id, o) in ids.iter().zip(out.iter_mut()) {
+        *o = value(*id);
+    }
+}
+
+/// Implements [`radiant_core::Sampler`] for a [`Pointwise`] type.
+macro_rules! pointwise_sampler {
+    ($ty:ty) => {
+        impl radiant_core::Sampler for $ty {
+            fn fill_2d(
+                &self,
+                ids: &[radiant_core::SampleId],
+                dim: u32,
+                out: &mut [radiant_core::glam::Vec2],
+            ) {
+                $crate::pointwise::fill(ids, out, |id| {
+                    $crate::pointwise::Pointwise::value_2d(self, id, dim)
+                });
+            }
+
+            fn fill_1d(&self, ids: &[radiant_core::SampleId], dim: u32, out: &mut [f32]) {
+                $crate::pointwise::fill(ids, out, |id| {
+                    $crate::pointwise::Pointwise::value_1d(self, id, dim)
+                });
+            }
+        }
+    };
+}
+
+pub(crate) use pointwise_sampler;
