@@ -1,11 +1,14 @@
 //! The `area` light: uniform, one-sided diffuse emission from a shape.
 //!
-//! Next-event estimation picks a primitive in proportion to its area, then
-//! a point on it: uniformly by area on triangles, and on spheres uniformly
-//! in the solid angle the sphere subtends when the reference point is
-//! outside it (uniformly by area from inside). `eval_hits` returns the
-//! density of the same strategy for the primitive that was hit.
+//! Next-event estimation picks a part of the shape in proportion to its
+//! area, then a point on it: on spheres uniformly in the solid angle the
+//! sphere subtends when the reference point is outside it, on rectangles
+//! (pairs of triangles that form one, as `rectangle` and `cube` shapes
+//! tessellate) uniformly in the solid angle of the spherical rectangle
+//! ([`crate::rectangle`]), and otherwise uniformly by area. `eval_hits`
+//! returns the density of the same strategy for the part that was hit.
 
+use crate::rectangle::Rectangle;
 use crate::sphere::Cone;
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::warp::{square_to_uniform_sphere, square_to_uniform_triangle};
@@ -28,14 +31,37 @@ const DOCS: &[ParamDoc] = &[ParamDoc {
     doc: "Emitted radiance, the same at every point and in every direction of the front side.",
 }];
 
+/// What next-event estimation samples as one unit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Part {
+    /// A triangle, by area.
+    Triangle([Vec3; 3]),
+    /// Two triangles forming a rectangle, by solid angle where reliable.
+    Rectangle(Rectangle),
+    /// A sphere (centre, radius), by solid angle from outside.
+    Sphere(Vec3, f32),
+}
+
+impl Part {
+    fn area(&self) -> f64 {
+        match *self {
+            Part::Triangle([a, b, c]) => 0.5 * (b - a).cross(c - a).length() as f64,
+            Part::Rectangle(r) => r.area() as f64,
+            Part::Sphere(_, r) => 4.0 * std::f64::consts::PI * (r as f64).powi(2),
+        }
+    }
+}
+
 /// Diffuse emission from the front side (the side the normal points to) of
-/// every primitive of a shape. Points are sampled uniformly by area, or by
-/// solid angle on spheres seen from outside.
+/// every primitive of a shape. Points are sampled by solid angle on
+/// spheres seen from outside and on rectangles, by area elsewhere.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AreaLight {
     radiance: Rgb,
-    shape: EmitterShape,
-    /// Cumulative areas of the primitives (triangles, then spheres).
+    parts: Vec<Part>,
+    /// The part of each primitive of the shape (triangles, then spheres).
+    part_of: Vec<u32>,
+    /// Cumulative areas of the parts.
     cdf: Vec<f32>,
     area: f32,
 }
@@ -43,14 +69,35 @@ pub struct AreaLight {
 impl AreaLight {
     /// An area light over `shape` with constant `radiance`.
     pub fn new(radiance: Rgb, shape: EmitterShape) -> Result<Self, String> {
-        let mut cdf = Vec::with_capacity(shape.triangles.len() + shape.spheres.len());
-        let mut total = 0.0f64;
-        for [a, b, c] in &shape.triangles {
-            total += 0.5 * (*b - *a).cross(*c - *a).length() as f64;
-            cdf.push(total as f32);
+        let mut parts = Vec::with_capacity(shape.triangles.len() + shape.spheres.len());
+        let mut part_of = Vec::with_capacity(parts.capacity());
+        let mut i = 0;
+        while i < shape.triangles.len() {
+            let pair = shape
+                .triangles
+                .get(i + 1)
+                .and_then(|t1| Rectangle::from_triangles(shape.triangles[i], *t1));
+            part_of.push(parts.len() as u32);
+            match pair {
+                Some(rect) => {
+                    part_of.push(parts.len() as u32);
+                    parts.push(Part::Rectangle(rect));
+                    i += 2;
+                }
+                None => {
+                    parts.push(Part::Triangle(shape.triangles[i]));
+                    i += 1;
+                }
+            }
         }
-        for (_, r) in &shape.spheres {
-            total += 4.0 * std::f64::consts::PI * (*r as f64).powi(2);
+        for &(centre, r) in &shape.spheres {
+            part_of.push(parts.len() as u32);
+            parts.push(Part::Sphere(centre, r));
+        }
+        let mut cdf = Vec::with_capacity(parts.len());
+        let mut total = 0.0f64;
+        for part in &parts {
+            total += part.area();
             cdf.push(total as f32);
         }
         if !(total > 0.0 && total.is_finite()) {
@@ -58,13 +105,14 @@ impl AreaLight {
         }
         Ok(Self {
             radiance,
-            shape,
+            parts,
+            part_of,
             cdf,
             area: total as f32,
         })
     }
 
-    /// Picks a primitive in proportion to its area and returns it with `u`
+    /// Picks a part in proportion to its area and returns it with `u`
     /// rescaled to [0,1) for reuse.
     #[inline]
     fn pick(&self, u: f32) -> (usize, f32) {
@@ -83,48 +131,59 @@ impl AreaLight {
         (i, rescaled)
     }
 
-    /// Probability of picking primitive `prim`.
+    /// Probability of picking part `part`.
     #[inline]
-    fn prim_probability(&self, prim: usize) -> f32 {
-        let lo = if prim == 0 { 0.0 } else { self.cdf[prim - 1] };
-        (self.cdf[prim] - lo) / self.area
+    fn part_probability(&self, part: usize) -> f32 {
+        let lo = if part == 0 { 0.0 } else { self.cdf[part - 1] };
+        (self.cdf[part] - lo) / self.area
     }
 
-    /// The sphere primitive `prim` with its subtended cone from `origin`,
-    /// if `prim` is a sphere and `origin` lies outside it.
+    /// A point on part `part` (with its normal) for `origin`, and the
+    /// solid-angle density of the whole strategy for it.
     #[inline]
-    fn cone(&self, prim: usize, origin: Vec3) -> Option<(Vec3, f32, Cone)> {
-        let (centre, r) = *self
-            .shape
-            .spheres
-            .get(prim.checked_sub(self.shape.triangles.len())?)?;
-        Cone::new(centre, r, origin).map(|cone| (centre, r, cone))
+    fn sample_part(&self, part: usize, origin: Vec3, u: Vec2) -> (Vec3, Vec3, f32) {
+        let (p, n) = match self.parts[part] {
+            Part::Triangle([a, b, c]) => {
+                let bary = square_to_uniform_triangle(u);
+                let p = a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y;
+                (p, (b - a).cross(c - a).normalize())
+            }
+            Part::Rectangle(rect) => match rect.spherical(origin) {
+                Some(s) => {
+                    let pdf = self.part_probability(part) / s.solid_angle as f32;
+                    return (s.sample(u), rect.n, pdf);
+                }
+                None => (rect.point(u), rect.n),
+            },
+            Part::Sphere(centre, r) => match Cone::new(centre, r, origin) {
+                Some(cone) => cone.sample(centre, r, origin, u),
+                None => {
+                    let n = square_to_uniform_sphere(u);
+                    (centre + n * r, n)
+                }
+            },
+        };
+        (p, n, self.pdf(part, origin, p, n))
     }
 
-    /// A point and normal on primitive `prim`, uniformly by area.
-    #[inline]
-    fn point_on(&self, prim: usize, u: Vec2) -> (Vec3, Vec3) {
-        let ntri = self.shape.triangles.len();
-        if prim < ntri {
-            let [a, b, c] = self.shape.triangles[prim];
-            let bary = square_to_uniform_triangle(u);
-            let p = a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y;
-            (p, (b - a).cross(c - a).normalize())
-        } else {
-            let (centre, r) = self.shape.spheres[prim - ntri];
-            let n = square_to_uniform_sphere(u);
-            (centre + n * r, n)
-        }
-    }
-
-    /// Solid-angle density of sampling point `p` (normal `n`) of primitive
-    /// `prim` from `origin`; 0 if `p` faces away. (A sphere seen from
+    /// Solid-angle density of sampling point `p` (normal `n`) of part
+    /// `part` from `origin`; 0 if `p` faces away. (A sphere seen from
     /// outside is only ever seen, and sampled, on its front cap, so its
     /// density does not depend on the rounding of `n` at the silhouette.)
     #[inline]
-    fn pdf(&self, prim: usize, origin: Vec3, p: Vec3, n: Vec3) -> f32 {
-        if let Some((_, _, cone)) = self.cone(prim, origin) {
-            return self.prim_probability(prim) * cone.pdf();
+    fn pdf(&self, part: usize, origin: Vec3, p: Vec3, n: Vec3) -> f32 {
+        match self.parts[part] {
+            Part::Sphere(centre, r) => {
+                if let Some(cone) = Cone::new(centre, r, origin) {
+                    return self.part_probability(part) * cone.pdf();
+                }
+            }
+            Part::Rectangle(rect) => {
+                if let Some(s) = rect.spherical(origin) {
+                    return self.part_probability(part) / s.solid_angle as f32;
+                }
+            }
+            Part::Triangle(_) => {}
         }
         let d = origin - p;
         let dist2 = d.length_squared();
@@ -148,13 +207,8 @@ impl Light for AreaLight {
 
     fn sample(&self, refs: &[Vec3], u: &[Vec2], out: &mut [LightSample]) {
         for ((r, u), o) in refs.iter().zip(u).zip(out.iter_mut()) {
-            let (prim, ux) = self.pick(u.x);
-            let u = Vec2::new(ux, u.y);
-            let (p, n) = match self.cone(prim, *r) {
-                Some((centre, radius, cone)) => cone.sample(centre, radius, *r, u),
-                None => self.point_on(prim, u),
-            };
-            let pdf = self.pdf(prim, *r, p, n);
+            let (part, ux) = self.pick(u.x);
+            let (p, n, pdf) = self.sample_part(part, *r, Vec2::new(ux, u.y));
             *o = if pdf > 0.0 && pdf.is_finite() {
                 LightSample {
                     p,
@@ -174,10 +228,10 @@ impl Light for AreaLight {
     }
 
     fn eval_hits(&self, hits: &[EmitterHit], out: &mut [EmitterEval]) {
-        let nprims = self.cdf.len();
+        let last = self.part_of.len() - 1;
         for (h, o) in hits.iter().zip(out.iter_mut()) {
-            let prim = (h.primitive as usize).min(nprims - 1);
-            let pdf = self.pdf(prim, h.origin, h.p, h.n);
+            let part = self.part_of[(h.primitive as usize).min(last)] as usize;
+            let pdf = self.pdf(part, h.origin, h.p, h.n);
             *o = if pdf > 0.0 {
                 EmitterEval {
                     radiance: self.radiance,

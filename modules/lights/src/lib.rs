@@ -11,6 +11,7 @@ mod environment;
 mod map_file;
 mod params;
 mod point;
+mod rectangle;
 mod sphere;
 mod spot;
 
