@@ -106,9 +106,9 @@ fn closed_box_with_a_light_terminates_with_unlimited_depth() {
 }
 
 /// Allowed |pixel − 1| in the white furnace. Measured at 64 spp, seeds
-/// 1–3: at most 0.098 (1024 pixels of unlimited-depth diffuse paths).
+/// 1–3: at most 0.126 (1024 pixels of unlimited-depth diffuse paths).
 const SPHERE_FURNACE_PIXEL: f32 = 0.2;
-/// Allowed |image mean − 1| in the white furnace. Measured: at most 0.0004.
+/// Allowed |image mean − 1| in the white furnace. Measured: at most 0.0012.
 const SPHERE_FURNACE_MEAN: f64 = 0.004;
 
 #[test]
