@@ -150,20 +150,23 @@ impl AreaLight {
             }
             Part::Rectangle(rect) => match rect.spherical(origin) {
                 Some(s) => {
-                    let pdf = self.part_probability(part) / s.solid_angle as f32;
+                    let pdf = self.part_probability(part) / s.solid_angle;
                     return (s.sample(u), rect.n, pdf);
                 }
                 None => (rect.point(u), rect.n),
             },
             Part::Sphere(centre, r) => match Cone::new(centre, r, origin) {
-                Some(cone) => cone.sample(centre, r, origin, u),
+                Some(cone) => {
+                    let (p, n) = cone.sample(centre, r, origin, u);
+                    return (p, n, self.part_probability(part) * cone.pdf());
+                }
                 None => {
                     let n = square_to_uniform_sphere(u);
                     (centre + n * r, n)
                 }
             },
         };
-        (p, n, self.pdf(part, origin, p, n))
+        (p, n, self.area_pdf(origin, p, n))
     }
 
     /// Solid-angle density of sampling point `p` (normal `n`) of part
@@ -180,11 +183,18 @@ impl AreaLight {
             }
             Part::Rectangle(rect) => {
                 if let Some(s) = rect.spherical(origin) {
-                    return self.part_probability(part) / s.solid_angle as f32;
+                    return self.part_probability(part) / s.solid_angle;
                 }
             }
             Part::Triangle(_) => {}
         }
+        self.area_pdf(origin, p, n)
+    }
+
+    /// Solid-angle density of point `p` (normal `n`) from `origin` when
+    /// its part is sampled by area; 0 if `p` faces away.
+    #[inline]
+    fn area_pdf(&self, origin: Vec3, p: Vec3, n: Vec3) -> f32 {
         let d = origin - p;
         let dist2 = d.length_squared();
         let cos_l = n.dot(d) / dist2.sqrt();

@@ -8,17 +8,18 @@
 //! grazing angles and gives near points a density that varies with
 //! distance squared; solid-angle sampling makes the estimator's density
 //! constant over the rectangle's image, which removes most of the variance
-//! of direct light from large or nearby rectangles. The maths runs in
-//! double precision; where the solid angle is too small for it to be
-//! reliable (or nearly a hemisphere), the light falls back to area
+//! of direct light from large or nearby rectangles. It is used only near
+//! the rectangle (within about two diagonals), where the solid angle is
+//! large enough for single precision; elsewhere, and where the solid angle
+//! is tiny (grazing) or nearly a hemisphere, the light falls back to area
 //! sampling, and its density follows the same rule.
 
-use radiant_core::glam::{DVec3, Vec2, Vec3};
+use radiant_core::glam::{Vec2, Vec3};
 
 /// Solid angles (sr) between which a rectangle is sampled by solid angle;
 /// outside, by area (pbrt-v4's bounds).
-const MIN_SOLID_ANGLE: f64 = 3e-4;
-const MAX_SOLID_ANGLE: f64 = 6.22;
+const MIN_SOLID_ANGLE: f32 = 3e-4;
+const MAX_SOLID_ANGLE: f32 = 6.22;
 /// Points farther from the rectangle's centre than √(NEAR · area) sample
 /// it by area: there its image is small and nearly undistorted, area
 /// sampling is almost uniform in solid angle already, and the spherical
@@ -33,6 +34,8 @@ pub(crate) struct Rectangle {
     pub ex: Vec3,
     pub ey: Vec3,
     pub n: Vec3,
+    centre: Vec3,
+    area: f32,
 }
 
 impl Rectangle {
@@ -52,17 +55,24 @@ impl Rectangle {
         let n = (t0[1] - t0[0]).cross(t0[2] - t0[0]).try_normalize()?;
         let closes = (a + ex + ey - c).length() <= 1e-5 * scale;
         let square = ex.dot(ey).abs() <= 1e-5 * ex.length() * ey.length();
-        (closes && square).then_some(Self {
-            corner: a,
+        (closes && square).then(|| Self::new(a, ex, ey, n))
+    }
+
+    /// The rectangle `corner + s·ex + t·ey` emitting towards `n`.
+    pub fn new(corner: Vec3, ex: Vec3, ey: Vec3, n: Vec3) -> Self {
+        Self {
+            corner,
             ex,
             ey,
             n,
-        })
+            centre: corner + 0.5 * (ex + ey),
+            area: ex.cross(ey).length(),
+        }
     }
 
     /// Area.
     pub fn area(&self) -> f32 {
-        self.ex.cross(self.ey).length()
+        self.area
     }
 
     /// The point at (s, t) ∈ [0, 1]².
@@ -75,19 +85,13 @@ impl Rectangle {
     /// within the reliable range.
     #[inline]
     pub fn spherical(&self, origin: Vec3) -> Option<SphericalRectangle> {
-        let to_centre = self.corner + 0.5 * (self.ex + self.ey) - origin;
         if self.n.dot(origin - self.corner) <= 0.0
-            || to_centre.length_squared() > NEAR * self.area()
+            || (self.centre - origin).length_squared() > NEAR * self.area
         {
             return None;
         }
-        SphericalRectangle::new(
-            origin.as_dvec3(),
-            self.corner.as_dvec3(),
-            self.ex.as_dvec3(),
-            self.ey.as_dvec3(),
-        )
-        .filter(|s| (MIN_SOLID_ANGLE..MAX_SOLID_ANGLE).contains(&s.solid_angle))
+        SphericalRectangle::new(origin, self.corner, self.ex, self.ey)
+            .filter(|s| (MIN_SOLID_ANGLE..MAX_SOLID_ANGLE).contains(&s.solid_angle))
     }
 }
 
@@ -95,36 +99,36 @@ impl Rectangle {
 /// uniform sampling.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct SphericalRectangle {
-    origin: DVec3,
+    origin: Vec3,
     /// Local frame: x along `ex`, y along `ey`, z away from the rectangle.
-    x: DVec3,
-    y: DVec3,
-    z: DVec3,
-    x0: f64,
-    x1: f64,
-    y0: f64,
-    y1: f64,
-    z0: f64,
-    b0: f64,
-    b1: f64,
+    x: Vec3,
+    y: Vec3,
+    z: Vec3,
+    x0: f32,
+    x1: f32,
+    y0: f32,
+    y1: f32,
+    z0: f32,
+    b0: f32,
+    b1: f32,
     /// Internal angles g0 + g1 − 2π and g2 + g3.
-    k0: f64,
-    k1: f64,
+    k0: f32,
+    k1: f32,
     /// Solid angle, steradians.
-    pub solid_angle: f64,
+    pub solid_angle: f32,
 }
 
 /// The angle between unit vectors, precise near 0 and π.
-fn angle_between(a: DVec3, b: DVec3) -> f64 {
+fn angle_between(a: Vec3, b: Vec3) -> f32 {
     if a.dot(b) < 0.0 {
-        std::f64::consts::PI - 2.0 * ((a + b).length() * 0.5).min(1.0).asin()
+        std::f32::consts::PI - 2.0 * ((a + b).length() * 0.5).min(1.0).asin()
     } else {
         2.0 * ((b - a).length() * 0.5).min(1.0).asin()
     }
 }
 
 impl SphericalRectangle {
-    fn new(origin: DVec3, corner: DVec3, ex: DVec3, ey: DVec3) -> Option<Self> {
+    fn new(origin: Vec3, corner: Vec3, ex: Vec3, ey: Vec3) -> Option<Self> {
         let (exl, eyl) = (ex.length(), ey.length());
         let x = ex / exl;
         let y = ey / eyl;
@@ -137,10 +141,10 @@ impl SphericalRectangle {
         }
         let (x0, y0) = (d.dot(x), d.dot(y));
         let (x1, y1) = (x0 + exl, y0 + eyl);
-        let v00 = DVec3::new(x0, y0, z0);
-        let v01 = DVec3::new(x0, y1, z0);
-        let v10 = DVec3::new(x1, y0, z0);
-        let v11 = DVec3::new(x1, y1, z0);
+        let v00 = Vec3::new(x0, y0, z0);
+        let v01 = Vec3::new(x0, y1, z0);
+        let v10 = Vec3::new(x1, y0, z0);
+        let v11 = Vec3::new(x1, y1, z0);
         let n0 = v00.cross(v10).try_normalize()?;
         let n1 = v10.cross(v11).try_normalize()?;
         let n2 = v11.cross(v01).try_normalize()?;
@@ -149,7 +153,7 @@ impl SphericalRectangle {
         let g1 = angle_between(-n1, n2);
         let g2 = angle_between(-n2, n3);
         let g3 = angle_between(-n3, n0);
-        let two_pi = 2.0 * std::f64::consts::PI;
+        let two_pi = 2.0 * std::f32::consts::PI;
         let solid_angle = g0 + g1 + g2 + g3 - two_pi;
         (solid_angle > 0.0 && solid_angle.is_finite()).then_some(Self {
             origin,
@@ -172,13 +176,13 @@ impl SphericalRectangle {
     /// The point of the rectangle in the direction drawn uniformly in solid
     /// angle from `u`.
     pub fn sample(&self, u: Vec2) -> Vec3 {
-        let (u0, u1) = (u.x as f64, u.y as f64);
+        let (u0, u1) = (u.x, u.y);
         // The x coordinate: invert the solid angle swept as x grows.
         let au = u0 * self.k0 + (u0 - 1.0) * self.k1;
         let fu = (au.cos() * self.b0 - self.b1) / au.sin();
         let cu = (1.0 / (fu * fu + self.b0 * self.b0).sqrt())
             .copysign(fu)
-            .clamp(-1.0 + 1e-12, 1.0 - 1e-12);
+            .clamp(-1.0 + 1e-7, 1.0 - 1e-7);
         let xu = (-(cu * self.z0) / (1.0 - cu * cu).max(0.0).sqrt()).clamp(self.x0, self.x1);
         // The y coordinate: uniform in the sine of the elevation.
         let dd = (xu * xu + self.z0 * self.z0).sqrt();
@@ -186,12 +190,12 @@ impl SphericalRectangle {
         let h1 = self.y1 / (dd * dd + self.y1 * self.y1).sqrt();
         let hv = h0 + u1 * (h1 - h0);
         let hv2 = hv * hv;
-        let yv = if hv2 < 1.0 - 1e-12 {
+        let yv = if hv2 < 1.0 - 1e-6 {
             (hv * dd / (1.0 - hv2).sqrt()).clamp(self.y0, self.y1)
         } else {
             self.y1
         };
-        (self.origin + self.x * xu + self.y * yv + self.z * self.z0).as_vec3()
+        self.origin + self.x * xu + self.y * yv + self.z * self.z0
     }
 }
 
@@ -200,12 +204,12 @@ mod tests {
     use super::*;
 
     fn square() -> Rectangle {
-        Rectangle {
-            corner: Vec3::new(-1.0, -1.0, 0.0),
-            ex: Vec3::new(2.0, 0.0, 0.0),
-            ey: Vec3::new(0.0, 2.0, 0.0),
-            n: Vec3::Z,
-        }
+        Rectangle::new(
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::Z,
+        )
     }
 
     #[test]
@@ -233,10 +237,10 @@ mod tests {
         // 4·asin(1/(1 + h²)) sr.
         for h in [0.1f32, 1.0, 3.9] {
             let s = square().spherical(Vec3::new(0.0, 0.0, h));
-            let exact = 4.0 * (1.0 / (1.0 + (h * h) as f64)).asin();
+            let exact = 4.0 * (1.0 / (1.0 + h * h)).asin();
             match s {
                 Some(s) => assert!(
-                    (s.solid_angle / exact - 1.0).abs() < 1e-6,
+                    (s.solid_angle / exact - 1.0).abs() < 1e-5,
                     "h = {h}: {} against {exact}",
                     s.solid_angle
                 ),
