@@ -204,18 +204,11 @@ fn write_atomic(
         path: path.to_path_buf(),
         message,
     };
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
     let suffix = path
         .extension()
         .map_or_else(String::new, |e| format!(".{}", e.to_string_lossy()));
-    let tmp = tempfile::Builder::new()
-        .prefix(".radiant-")
-        .suffix(&suffix)
-        .tempfile_in(dir)
-        .map_err(|e| err(e.to_string()))?;
+    let tmp =
+        crate::film::output::temp_file_beside(path, &suffix).map_err(|e| err(e.to_string()))?;
     write(tmp.path()).map_err(err)?;
     tmp.persist(path).map_err(|e| err(e.error.to_string()))?;
     Ok(())

@@ -43,6 +43,26 @@ pub fn srgb_encode(linear: f32) -> f32 {
     }
 }
 
+/// A hidden temporary file in the folder of `path` (ending in `suffix`),
+/// to be renamed onto `path` once complete, so that an interrupted write
+/// never leaves a broken file. It is created with the permissions a plain
+/// `File::create` would give (0o666 less the umask), not tempfile's private
+/// 0o600, so the renamed result is as readable as any other output.
+pub fn temp_file_beside(path: &Path, suffix: &str) -> std::io::Result<tempfile::NamedTempFile> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".radiant-").suffix(suffix);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    builder.tempfile_in(dir)
+}
+
 /// Writes `image` to `path`, choosing the format by extension.
 pub fn write(path: impl AsRef<Path>, image: &Image) -> Result<(), ImageError> {
     let path = path.as_ref();
@@ -55,15 +75,7 @@ pub fn write(path: impl AsRef<Path>, image: &Image) -> Result<(), ImageError> {
         Some("exr") => Format::Exr,
         _ => return Err(ImageError::UnknownFormat(path.display().to_string())),
     };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".radiant-")
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map_err(|e| io_error(path, e))?;
+    let mut tmp = temp_file_beside(path, ".tmp").map_err(|e| io_error(path, e))?;
     match format {
         Format::Png => write_png(tmp.as_file_mut(), image),
         Format::Exr => write_exr(tmp.as_file_mut(), image),
@@ -145,6 +157,24 @@ pub fn read_exr(path: impl AsRef<Path>) -> Result<Image, ImageError> {
 mod tests {
     use super::*;
     use radiant_core::Rgb;
+
+    #[cfg(unix)]
+    #[test]
+    fn outputs_get_the_permissions_of_a_plain_file() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let plain = dir.path().join("plain");
+        std::fs::File::create(&plain).unwrap();
+        let out = dir.path().join("out.png");
+        let image = Image {
+            width: 1,
+            height: 1,
+            pixels: vec![Rgb::splat(0.5)],
+        };
+        write(&out, &image).unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&out), mode(&plain));
+    }
 
     fn sample_image() -> Image {
         Image {
