@@ -2,7 +2,7 @@
 //! with the density it produces.
 
 use glam::{Vec2, Vec3};
-use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
+use std::f32::consts::{FRAC_1_PI, FRAC_PI_4, PI};
 
 /// Maps the unit square to the unit disk with Shirley–Chiu's concentric map.
 #[inline]
@@ -11,13 +11,31 @@ pub fn square_to_disk_concentric(u: Vec2) -> Vec2 {
     if o.x == 0.0 && o.y == 0.0 {
         return Vec2::ZERO;
     }
-    let (r, theta) = if o.x.abs() > o.y.abs() {
-        (o.x, FRAC_PI_4 * (o.y / o.x))
+    // θ = φ or π/2 − φ with |φ| ≤ π/4, so only sin φ and cos φ are needed.
+    if o.x.abs() > o.y.abs() {
+        let (s, c) = sin_cos_quarter(FRAC_PI_4 * (o.y / o.x));
+        Vec2::new(c, s) * o.x
     } else {
-        (o.y, FRAC_PI_2 - FRAC_PI_4 * (o.x / o.y))
-    };
-    let (s, c) = theta.sin_cos();
-    Vec2::new(c, s) * r
+        let (s, c) = sin_cos_quarter(FRAC_PI_4 * (o.x / o.y));
+        Vec2::new(s, c) * o.y
+    }
+}
+
+/// sin φ and cos φ for |φ| ≤ π/4 by their Taylor series to the φ⁹ and φ¹⁰
+/// terms: the truncation error is below 2e-9, under single-precision
+/// rounding, and the hot sampling path needs no call into libm.
+#[inline]
+fn sin_cos_quarter(phi: f32) -> (f32, f32) {
+    let x2 = phi * phi;
+    let sin = phi
+        * (1.0
+            + x2 * (-1.0 / 6.0
+                + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362_880.0)))));
+    let cos = 1.0
+        + x2 * (-0.5
+            + x2 * (1.0 / 24.0
+                + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40_320.0 + x2 * (-1.0 / 3_628_800.0)))));
+    (sin, cos)
 }
 
 /// Cosine-weighted direction on the +z hemisphere.
@@ -57,6 +75,32 @@ pub fn square_to_uniform_triangle(u: Vec2) -> Vec2 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f32::consts::FRAC_1_SQRT_2;
+
+    #[test]
+    fn quarter_sin_cos_matches_libm() {
+        for i in 0..=10_000 {
+            let phi = FRAC_PI_4 * (2.0 * i as f32 / 10_000.0 - 1.0);
+            let (s, c) = sin_cos_quarter(phi);
+            let (es, ec) = (phi as f64).sin_cos();
+            assert!((s as f64 - es).abs() < 2e-7, "sin {phi}: {s} vs {es}");
+            assert!((c as f64 - ec).abs() < 2e-7, "cos {phi}: {c} vs {ec}");
+        }
+    }
+
+    #[test]
+    fn concentric_disk_keeps_its_quadrants_and_radius() {
+        for (u, x, y) in [
+            (Vec2::new(1.0, 0.5), 1.0, 0.0),
+            (Vec2::new(0.5, 1.0), 0.0, 1.0),
+            (Vec2::new(0.0, 0.5), -1.0, 0.0),
+            (Vec2::new(0.5, 0.0), 0.0, -1.0),
+            (Vec2::new(1.0, 1.0), FRAC_1_SQRT_2, FRAC_1_SQRT_2),
+        ] {
+            let d = square_to_disk_concentric(u);
+            assert!((d - Vec2::new(x, y)).length() < 1e-6, "{u} → {d}");
+        }
+    }
 
     fn grid(n: usize) -> impl Iterator<Item = Vec2> {
         (0..n * n).map(move |i| {
