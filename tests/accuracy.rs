@@ -6,6 +6,9 @@
 //! measurements (seeded, thread-count independent) are the same on a
 //! loaded machine as on an idle one.
 
+// `unwrap` in this test code is the assertion: the inputs are the test's
+// own, so a failure is a bug, and the panic reports it with the error.
+
 use radiant::accuracy::report::{CSV_HEADER, log_log_slope};
 use radiant::accuracy::{self, Axis, Config, Reference, Report};
 use radiant::extract::Overrides;

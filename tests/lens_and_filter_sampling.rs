@@ -2,6 +2,9 @@
 //! against their own densities (the shaders' and lights' are in
 //! `sampling.rs`).
 
+// `unwrap` in this test code is the assertion: the inputs are the test's
+// own, so a failure is a bug, and the panic reports it with the error.
+
 use glam::{Mat4, Vec2, Vec3};
 use radiant_cameras::{FovAxis, ThinLens};
 use radiant_core::{Camera, CameraRays, Filter, FilterSampler};

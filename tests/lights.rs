@@ -4,6 +4,9 @@
 //! distribution they build on, and the environment map's lookup against
 //! Mitsuba 3's `envmap` texel by texel.
 
+// `unwrap` in this test code is the assertion: the inputs are the test's
+// own, so a failure is a bug, and the panic reports it with the error.
+
 use glam::{Mat3, UVec2, Vec2, Vec3};
 use radiant::film::output::read_exr;
 use radiant_core::{BoundingSphere, EmitterEval, Light, LightSample, Rgb};

@@ -2,6 +2,9 @@
 //! BSDF sampling of the shaders, area-light sampling (triangles and
 //! spheres), and the warps they are built on.
 
+// `unwrap` in this test code is the assertion: the inputs are the test's
+// own, so a failure is a bug, and the panic reports it with the error.
+
 use glam::{Vec2, Vec3};
 use radiant::accel::{Accel, BuildQuality, Primitive};
 use radiant_core::warp::{UNIFORM_SPHERE_PDF, square_to_uniform_sphere};

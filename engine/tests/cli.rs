@@ -1,5 +1,8 @@
 //! The `radiant` command line, end to end.
 
+// `unwrap` in this test code is the assertion: the inputs are the test's
+// own, so a failure is a bug, and the panic reports it with the error.
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

@@ -13,10 +13,11 @@
 //! ```no_run
 //! use radiant::accuracy::{Config, run, write};
 //! let registry = radiant::builtin_registry();
-//! let mut scene = radiant::scene::load("scenes/cornell-box.yaml").unwrap();
+//! let mut scene = radiant::scene::load("scenes/cornell-box.yaml")?;
 //! let config = Config::new(std::time::Duration::from_secs(30));
-//! let report = run(&mut scene, &registry, &config, None, &|line| eprintln!("{line}")).unwrap();
-//! write(&report, "accuracy-out".as_ref()).unwrap();
+//! let report = run(&mut scene, &registry, &config, None, &|line| eprintln!("{line}"))?;
+//! write(&report, "accuracy-out".as_ref())?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 pub mod metrics;

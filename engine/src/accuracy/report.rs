@@ -337,6 +337,8 @@ pub fn summary(report: &Report) -> String {
 
 #[cfg(test)]
 mod tests {
+    // `unwrap` in this test code is the assertion: the inputs are the test's
+    // own, so a failure is a bug, and the panic reports it with the error.
     use super::*;
     use crate::accuracy::Axis;
     use crate::accuracy::metrics::{BiasSplit, Metrics};

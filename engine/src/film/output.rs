@@ -155,6 +155,8 @@ pub fn read_exr(path: impl AsRef<Path>) -> Result<Image, ImageError> {
 
 #[cfg(test)]
 mod tests {
+    // `unwrap` in this test code is the assertion: the inputs are the test's
+    // own, so a failure is a bug, and the panic reports it with the error.
     use super::*;
     use radiant_core::Rgb;
 

@@ -1,6 +1,9 @@
 //! Round trips: every camera's rays land where its projection maths says,
 //! for a rotated and translated pose on a non-square film.
 
+// `unwrap` in this test code is the assertion: the inputs are the test's
+// own, so a failure is a bug, and the panic reports it with the error.
+
 use super::*;
 use radiant_core::glam::{Mat4, Quat, Vec2, Vec3};
 use radiant_core::{Camera, CameraRays};

@@ -201,6 +201,8 @@ impl SphericalRectangle {
 
 #[cfg(test)]
 mod tests {
+    // `unwrap` in this test code is the assertion: the inputs are the test's
+    // own, so a failure is a bug, and the panic reports it with the error.
     use super::*;
 
     fn square() -> Rectangle {

@@ -3,6 +3,9 @@
 //! data, every file format, the composite textures, and errors that name
 //! the parameter's line and column.
 
+// `unwrap` in this test code is the assertion: the inputs are the test's
+// own, so a failure is a bug, and the panic reports it with the error.
+
 use super::*;
 use radiant_core::glam::Vec2;
 use radiant_core::params::check_param_docs;
