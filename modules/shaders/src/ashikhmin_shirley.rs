@@ -11,7 +11,7 @@
 
 use crate::fresnel::schlick;
 use crate::half_vector::{HalfVectorLobes, HalfVectorShader, specular_probability};
-use crate::inputs::{checked, fraction, scalar};
+use crate::inputs::{checked, fraction, half, scalar};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::cosine_hemisphere_pdf;
@@ -22,7 +22,7 @@ use std::f32::consts::{FRAC_PI_2, PI};
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct AsParams {
-    #[serde(default = "diffuse_default")]
+    #[serde(default = "half")]
     diffuse_reflectance: Spanned<TextureInput>,
     #[serde(default = "specular_default")]
     specular_reflectance: Spanned<TextureInput>,
@@ -30,10 +30,6 @@ struct AsParams {
     exponent_u: Spanned<TextureInput>,
     #[serde(default = "exponent_default")]
     exponent_v: Spanned<TextureInput>,
-}
-
-fn diffuse_default() -> Spanned<TextureInput> {
-    TextureInput::spanned_value(Rgb::splat(0.5))
 }
 
 fn specular_default() -> Spanned<TextureInput> {

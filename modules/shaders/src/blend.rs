@@ -8,11 +8,11 @@
 //! keeps its component's weight, which is unbiased for the mix (a delta
 //! lobe of one component is not evaluated through the other).
 
-use crate::inputs::{fraction, scalar, texture_effects};
+use crate::inputs::{fraction, half, scalar, texture_effects};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry,
     ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
@@ -26,10 +26,6 @@ struct BlendParams {
     // Read through `BuildContext::material_at`; listed for key checking.
     #[serde(rename = "materials")]
     _materials: IgnoredAny,
-}
-
-fn half() -> Spanned<TextureInput> {
-    TextureInput::spanned_value(Rgb::splat(0.5))
 }
 
 const DOCS: &[ParamDoc] = &[

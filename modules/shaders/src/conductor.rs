@@ -5,7 +5,7 @@
 //! colour. Mitsuba 3's `conductor` and `roughconductor` in one module.
 
 use crate::fresnel;
-use crate::inputs::{ROUGHNESS_DOCS, Roughness, fraction, roughness, scalar, texture_effects};
+use crate::inputs::{ROUGHNESS_DOCS, Roughness, fraction, one, roughness, scalar, texture_effects};
 use crate::lobes::{mirror_sample, reflection_sample};
 use crate::metals;
 use crate::microfacet::{Ggx, reflect};
@@ -28,10 +28,6 @@ struct ConductorParams {
     alpha: Option<Spanned<TextureInput>>,
     alpha_u: Option<Spanned<TextureInput>>,
     alpha_v: Option<Spanned<TextureInput>>,
-}
-
-fn one() -> Spanned<TextureInput> {
-    TextureInput::spanned_value(Rgb::ONE)
 }
 
 const DOCS: &[ParamDoc] = &[

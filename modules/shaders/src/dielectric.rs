@@ -7,14 +7,15 @@
 
 use crate::fresnel;
 use crate::inputs::{
-    BK7, Ior, ROUGHNESS_DOCS, Roughness, fraction, relative_ior, roughness, scalar, texture_effects,
+    BK7, Ior, ROUGHNESS_DOCS, Roughness, fraction, one, relative_ior, roughness, scalar,
+    texture_effects,
 };
 use crate::lobes::{interface_eval, interface_sample, mirror_sample};
 use crate::microfacet::Ggx;
 use radiant_core::glam::Vec3;
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry,
     ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
@@ -31,10 +32,6 @@ struct DielectricParams {
     alpha: Option<Spanned<TextureInput>>,
     alpha_u: Option<Spanned<TextureInput>>,
     alpha_v: Option<Spanned<TextureInput>>,
-}
-
-fn one() -> Spanned<TextureInput> {
-    TextureInput::spanned_value(Rgb::ONE)
 }
 
 pub(crate) const INT_IOR_DOC: ParamDoc = ParamDoc {

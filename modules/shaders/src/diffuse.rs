@@ -1,11 +1,12 @@
 //! The `diffuse` shader: an ideal one-sided Lambertian reflector.
 
+use crate::inputs::half;
 use crate::lobes::reflection_sample;
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry,
     ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
@@ -14,12 +15,8 @@ use std::f32::consts::FRAC_1_PI;
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct DiffuseParams {
-    #[serde(default = "default_reflectance")]
+    #[serde(default = "half")]
     reflectance: Spanned<TextureInput>,
-}
-
-fn default_reflectance() -> Spanned<TextureInput> {
-    TextureInput::spanned_value(Rgb::splat(0.5))
 }
 
 const DOCS: &[ParamDoc] = &[ParamDoc {
@@ -112,6 +109,7 @@ pub(crate) fn register(registry: &mut Registry) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use radiant_core::Rgb;
     use radiant_core::TextureTable;
     use radiant_core::params::check_param_docs;
 

@@ -183,6 +183,21 @@ impl<'de> Deserialize<'de> for Ior {
     }
 }
 
+/// Serde default of a texture input: the constant 0.
+pub(crate) fn zero() -> Spanned<TextureInput> {
+    TextureInput::spanned_value(Rgb::ZERO)
+}
+
+/// Serde default of a texture input: the constant 0.5.
+pub(crate) fn half() -> Spanned<TextureInput> {
+    TextureInput::spanned_value(Rgb::splat(0.5))
+}
+
+/// Serde default of a texture input: the constant 1.
+pub(crate) fn one() -> Spanned<TextureInput> {
+    TextureInput::spanned_value(Rgb::ONE)
+}
+
 /// Mitsuba 3's default interior index of glass (BK7).
 pub(crate) const BK7: f32 = 1.5046;
 

@@ -7,7 +7,7 @@
 //! transmittance.
 
 use crate::fresnel;
-use crate::inputs::{Ior, fraction, relative_ior, scalar, texture_effects};
+use crate::inputs::{Ior, fraction, half, one, relative_ior, scalar, texture_effects};
 use crate::lobes::{glossy_eval, glossy_sample, mirror_sample, reflection_sample};
 use crate::microfacet::{Ggx, reflect, refract};
 use radiant_core::glam::{Vec2, Vec3};
@@ -32,14 +32,6 @@ struct PlasticParams {
     #[serde(default)]
     nonlinear: bool,
     alpha: Option<Spanned<f32>>,
-}
-
-fn half() -> Spanned<TextureInput> {
-    TextureInput::spanned_value(Rgb::splat(0.5))
-}
-
-fn one() -> Spanned<TextureInput> {
-    TextureInput::spanned_value(Rgb::ONE)
 }
 
 /// Polypropylene, Mitsuba 3's default for plastics.

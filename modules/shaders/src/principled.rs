@@ -18,7 +18,7 @@
 //! an albedo estimate, and the returned density is that of the whole mix.
 
 use crate::fresnel::schlick;
-use crate::inputs::{fraction, scalar, texture_effects};
+use crate::inputs::{fraction, half, scalar, texture_effects, zero};
 use crate::lobes::{glossy_eval, glossy_sample, interface_eval, interface_sample};
 use crate::microfacet::Ggx;
 use radiant_core::glam::{Vec2, Vec3};
@@ -44,14 +44,6 @@ struct PrincipledParams {
     specular: Spanned<TextureInput>,
     #[serde(default = "zero")]
     transmission: Spanned<TextureInput>,
-}
-
-fn half() -> Spanned<TextureInput> {
-    TextureInput::spanned_value(Rgb::splat(0.5))
-}
-
-fn zero() -> Spanned<TextureInput> {
-    TextureInput::spanned_value(Rgb::ZERO)
 }
 
 const DOCS: &[ParamDoc] = &[

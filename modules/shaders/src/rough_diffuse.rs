@@ -3,7 +3,7 @@
 //! as in Mitsuba 3's `roughdiffuse` (after Oren and Nayar 1994); sampled by
 //! the cosine-weighted hemisphere.
 
-use crate::inputs::{fraction, scalar, texture_effects};
+use crate::inputs::{fraction, half, scalar, texture_effects};
 use crate::lobes::reflection_sample;
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
@@ -22,10 +22,6 @@ struct RoughDiffuseParams {
     reflectance: Spanned<TextureInput>,
     #[serde(default = "point_two")]
     alpha: Spanned<TextureInput>,
-}
-
-fn half() -> Spanned<TextureInput> {
-    TextureInput::spanned_value(Rgb::splat(0.5))
 }
 
 fn point_two() -> Spanned<TextureInput> {

@@ -5,12 +5,12 @@
 
 use crate::dielectric::{EXT_IOR_DOC, INT_IOR_DOC};
 use crate::fresnel;
-use crate::inputs::{BK7, Ior, fraction, relative_ior, texture_effects};
+use crate::inputs::{BK7, Ior, fraction, one, relative_ior, texture_effects};
 use crate::lobes::mirror_sample;
 use radiant_core::glam::Vec3;
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
+    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry,
     ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
@@ -24,10 +24,6 @@ struct ThinParams {
     specular_reflectance: Spanned<TextureInput>,
     #[serde(default = "one")]
     specular_transmittance: Spanned<TextureInput>,
-}
-
-fn one() -> Spanned<TextureInput> {
-    TextureInput::spanned_value(Rgb::ONE)
 }
 
 const DOCS: &[ParamDoc] = &[

@@ -6,7 +6,7 @@
 //! f = ρd/π + ρs · exp(−tan²θh (cos²φh/αu² + sin²φh/αv²)) / (4π αu αv (wi·h)² cos⁴θh).
 
 use crate::half_vector::{HalfVectorLobes, HalfVectorShader, specular_probability};
-use crate::inputs::{checked, fraction, scalar};
+use crate::inputs::{checked, fraction, half, scalar};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::cosine_hemisphere_pdf;
@@ -17,7 +17,7 @@ use std::f32::consts::{FRAC_1_PI, PI};
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct WardParams {
-    #[serde(default = "diffuse_default")]
+    #[serde(default = "half")]
     diffuse_reflectance: Spanned<TextureInput>,
     #[serde(default = "specular_default")]
     specular_reflectance: Spanned<TextureInput>,
@@ -25,10 +25,6 @@ struct WardParams {
     alpha_u: Spanned<TextureInput>,
     #[serde(default = "alpha_default")]
     alpha_v: Spanned<TextureInput>,
-}
-
-fn diffuse_default() -> Spanned<TextureInput> {
-    TextureInput::spanned_value(Rgb::splat(0.5))
 }
 
 fn specular_default() -> Spanned<TextureInput> {
