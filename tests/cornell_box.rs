@@ -13,7 +13,7 @@
 use radiant::extract::Overrides;
 use radiant::film::Image;
 use radiant::film::output::read_exr;
-use radiant_tests::{ReferenceCheck, check_against, render_scene, root};
+use radiant_tests::{ReferenceCheck, check_against, render_edited, render_scene, root};
 
 const SPP: u32 = 512;
 /// Side of the blocks whose means are compared, in pixels.
@@ -87,23 +87,17 @@ const IMPORTANCE_BLOCK_TOLERANCE: f64 = 0.06;
 
 #[test]
 fn importance_sampled_filter_matches_mitsuba() {
-    let path = root().join("scenes/cornell-box.yaml");
-    let text = std::fs::read_to_string(&path).expect("scene readable");
     let film = "  filter: {type: gaussian, stddev: 0.5}";
-    assert!(text.contains(film));
-    let text = text.replace(
-        film,
-        "  filter_sampling: importance\n  filter: {type: gaussian, stddev: 0.5}",
-    );
-    let scene = radiant::scene::from_str(&text, &path, &root().join("scenes")).expect("parses");
+    let edit = |text: &str| {
+        assert!(text.contains(film));
+        text.replace(film, &format!("  filter_sampling: importance\n{film}"))
+    };
     let overrides = Overrides {
         spp: Some(SPP),
         seed: Some(3),
         ..Default::default()
     };
-    let r = radiant::extract::extract(&scene, &radiant::builtin_registry(), &overrides)
-        .expect("extracts");
-    let image = radiant::backend::cpu::render(&r, &radiant::backend::cpu::Progress::none()).image;
+    let image = render_edited("scenes/cornell-box.yaml", edit, overrides).image;
     let check = check_against(&image, &reference(), BLOCK);
     eprintln!("importance-sampled Gaussian: {check:?}");
     assert!(

@@ -11,11 +11,9 @@
 //! - `scenes/hard/rough-limits.yaml`: GGX at α = 1e-6 matches the smooth
 //!   (delta) mirror and glass.
 
-use radiant::extract::{Overrides, extract};
+use radiant::extract::Overrides;
 use radiant::film::Image;
-use radiant::scene::from_str;
-use radiant_tests::{Tolerances, check_against, render_checked, root};
-use std::path::Path;
+use radiant_tests::{Tolerances, check_against, render_checked, render_edited};
 
 fn seeded(seed: u64) -> Overrides {
     Overrides {
@@ -27,14 +25,11 @@ fn seeded(seed: u64) -> Overrides {
 /// Renders the scene file `scene` with every `from` in its text replaced by
 /// `to` (which must occur `count` times), checked like `render_checked`.
 fn render_variant(scene: &str, from: &str, to: &str, count: usize, overrides: Overrides) -> Image {
-    let path = root().join(scene);
-    let text = std::fs::read_to_string(&path).expect("scene readable");
-    assert_eq!(text.matches(from).count(), count, "{scene}: `{from}`");
-    let text = text.replace(from, to);
-    let dir = path.parent().expect("scene folder");
-    let loaded = from_str(&text, Path::new(scene), dir).expect("variant parses");
-    let r = extract(&loaded, &radiant::builtin_registry(), &overrides).expect("variant extracts");
-    let rendered = radiant::backend::cpu::render(&r, &radiant::backend::cpu::Progress::none());
+    let edit = |text: &str| {
+        assert_eq!(text.matches(from).count(), count, "{scene}: `{from}`");
+        text.replace(from, to)
+    };
+    let rendered = render_edited(scene, edit, overrides);
     assert_eq!(
         rendered.invalid_samples, 0,
         "{scene}: NaN or infinite samples"
@@ -125,17 +120,8 @@ fn lossy_materials_never_gain_energy_in_a_white_furnace() {
 
 /// Renders `scene`'s text cut at the line that contains `marker`.
 fn render_cut(scene: &str, marker: &str, overrides: Overrides) -> Image {
-    let path = root().join(scene);
-    let text = std::fs::read_to_string(&path).expect("scene readable");
-    let cut = text.find(marker).expect("marker present");
-    let loaded = from_str(
-        &text[..cut],
-        Path::new(scene),
-        path.parent().expect("folder"),
-    )
-    .expect("cut scene parses");
-    let r = extract(&loaded, &radiant::builtin_registry(), &overrides).expect("extracts");
-    radiant::backend::cpu::render(&r, &radiant::backend::cpu::Progress::none()).image
+    let cut = |text: &str| text[..text.find(marker).expect("marker present")].to_string();
+    render_edited(scene, cut, overrides).image
 }
 
 /// A high-spp render for comparisons.

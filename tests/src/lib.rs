@@ -1,7 +1,7 @@
 //! Helpers shared by Radiant's workspace-level tests: rendering a scene in
 //! process and comparing images statistically.
 
-use radiant::backend::cpu::{Progress, render};
+use radiant::backend::cpu::{Progress, Rendered, render};
 use radiant::extract::{Overrides, extract};
 use radiant::film::Image;
 use std::path::{Path, PathBuf};
@@ -17,6 +17,22 @@ pub fn render_scene(scene: &str, overrides: Overrides) -> Image {
     let scene = radiant::scene::load(root().join(scene)).expect("scene loads");
     let r = extract(&scene, &radiant::builtin_registry(), &overrides).expect("scene extracts");
     render(&r, &Progress::none()).image
+}
+
+/// Renders the scene file `scene` (relative to the workspace root) with its
+/// text changed by `edit` first, for variants of a committed scene.
+pub fn render_edited(
+    scene: &str,
+    edit: impl FnOnce(&str) -> String,
+    overrides: Overrides,
+) -> Rendered {
+    let path = root().join(scene);
+    let text = std::fs::read_to_string(&path).expect("scene readable");
+    let dir = path.parent().expect("scene folder");
+    let loaded =
+        radiant::scene::from_str(&edit(&text), Path::new(scene), dir).expect("edited scene parses");
+    let r = extract(&loaded, &radiant::builtin_registry(), &overrides).expect("scene extracts");
+    render(&r, &Progress::none())
 }
 
 /// Renders like [`render_scene`] and checks what every torture case must
