@@ -194,12 +194,7 @@ impl TileFilm {
     /// the filter's radius.
     #[inline]
     pub fn splat(&mut self, pos: Vec2, value: Rgb, table: &FilterTable) {
-        let value = if value.is_finite() {
-            value
-        } else {
-            self.invalid_samples += 1;
-            Rgb::ZERO
-        };
+        let value = self.checked(value);
         let r = table.radius;
         let px0 = ((pos.x - 0.5 - r).ceil() as i32).max(0);
         let px1 = ((pos.x - 0.5 + r).floor() as i32).min(self.image_width - 1);
@@ -235,19 +230,24 @@ impl TileFilm {
             }
         }
     }
-}
 
-impl TileFilm {
-    /// Adds `value` with filter weight `weight` to pixel (`x`, `y`) alone
-    /// (filter importance sampling).
+    /// `value`, or black (counted in `invalid_samples`) if it is NaN or
+    /// infinite.
     #[inline]
-    pub fn add(&mut self, x: u32, y: u32, value: Rgb, weight: f32) {
-        let value = if value.is_finite() {
+    fn checked(&mut self, value: Rgb) -> Rgb {
+        if value.is_finite() {
             value
         } else {
             self.invalid_samples += 1;
             Rgb::ZERO
-        };
+        }
+    }
+
+    /// Adds `value` with filter weight `weight` to pixel (`x`, `y`) alone
+    /// (filter importance sampling).
+    #[inline]
+    pub fn add(&mut self, x: u32, y: u32, value: Rgb, weight: f32) {
+        let value = self.checked(value);
         let i = ((y as i32 - self.y0) * self.width + x as i32 - self.x0) as usize;
         self.sums[i] += (value * weight).extend(weight);
     }
