@@ -190,13 +190,11 @@ impl Accel {
         if self.bvh.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return None;
         }
-        // The triangle test's constants are made at the first leaf: many
-        // rays (misses, short shadow rays) never reach one.
-        let mut prep = None;
+        let prep = RayPrep::new(origin, dir);
+        let prep = &prep;
         let mut best = None;
         self.bvh
             .closest(&RayBoxes::new(origin, dir), tmax, |range, mut tmax| {
-                let prep = prep.get_or_insert_with(|| RayPrep::new(origin, dir));
                 for packet in &self.packets[range] {
                     match *packet {
                         Packet::Triangles { ref tris, first } => {
@@ -238,9 +236,8 @@ impl Accel {
         if self.bvh.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return false;
         }
-        let mut prep = None;
+        let prep = &RayPrep::new(origin, dir);
         self.bvh.any(&RayBoxes::new(origin, dir), tmax, |range| {
-            let prep = prep.get_or_insert_with(|| RayPrep::new(origin, dir));
             self.packets[range].iter().any(|packet| match *packet {
                 Packet::Triangles { ref tris, .. } => tris.any(prep, tmax),
                 Packet::Sphere { centre, radius, .. } => {

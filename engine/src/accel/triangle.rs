@@ -26,10 +26,7 @@ pub struct RayPrep {
 
 impl RayPrep {
     /// Prepares the ray `origin + t·dir`.
-    ///
-    /// Not inlined, so that traversal really makes it only when a ray
-    /// reaches its first leaf (inlined, it gets hoisted to the start).
-    #[inline(never)]
+    #[inline(always)]
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
         let (o, d) = (Vec3A::from(origin), Vec3A::from(dir));
         let a = d.abs();
