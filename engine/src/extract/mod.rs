@@ -23,6 +23,7 @@ use glam::{DMat4, UVec2, Vec2, Vec3};
 use materials::NestedMaterials;
 use radiant_core::registry::ModuleType;
 use radiant_core::{
+    Frame,
     BoundingSphere, BuildContext, Camera, Effects, EmitterShape, Filter, Light, ModuleKind,
     Registry, Sampler, Shader, Texture, TextureTable,
 };
@@ -65,6 +66,9 @@ pub struct Surfaces {
     pub normals: Vec<[Vec3; 3]>,
     /// Vertex texture coordinates of triangles.
     pub uvs: Vec<[Vec2; 3]>,
+    /// Frame around the unit face normal of triangles (by winding), made
+    /// once here rather than at every hit; `n` is the geometric normal.
+    pub face_frames: Vec<Frame>,
 }
 
 /// Counts that `radiant info` reports.
@@ -306,15 +310,18 @@ pub fn extract(
         surfaces.emitter.push(emitter[i]);
         surfaces.emitter_prim.push(emitter_prim[i]);
         match prims[i] {
-            ShapePrim::Triangle { n, uv, .. } => {
+            ShapePrim::Triangle { v, n, uv } => {
                 stats.triangles += 1;
                 surfaces.normals.push(n);
                 surfaces.uvs.push(uv);
+                let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
+                surfaces.face_frames.push(Frame::from_normal(ng));
             }
             ShapePrim::Sphere { .. } => {
                 stats.spheres += 1;
                 surfaces.normals.push([Vec3::ZERO; 3]);
                 surfaces.uvs.push([Vec2::ZERO; 3]);
+                surfaces.face_frames.push(Frame::from_normal(Vec3::Z));
             }
         }
     }

@@ -48,24 +48,25 @@ pub fn interaction(scene: &RenderScene, hit: &Hit, origin: Vec3, dir: Vec3) -> I
         Primitive::Triangle(v) => {
             let b0 = 1.0 - hit.b1 - hit.b2;
             let p = v[0] * b0 + v[1] * hit.b1 + v[2] * hit.b2;
-            let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
+            let face = scene.surfaces.face_frames[i];
+            let ng = face.n;
             let n = scene.surfaces.normals[i];
-            let ns = if n[0] == Vec3::ZERO {
-                ng
+            let frame = if n[0] == Vec3::ZERO {
+                face
             } else {
-                above_tangent_plane(
+                Frame::from_normal(above_tangent_plane(
                     (n[0] * b0 + n[1] * hit.b1 + n[2] * hit.b2)
                         .try_normalize()
                         .unwrap_or(ng),
                     ng,
-                )
+                ))
             };
             let uv = scene.surfaces.uvs[i];
             Interaction {
                 p,
                 err: triangle_error(&v, b0, hit.b1, hit.b2),
                 ng,
-                frame: Frame::from_normal(ns),
+                frame,
                 uv: uv[0] * b0 + uv[1] * hit.b1 + uv[2] * hit.b2,
             }
         }
