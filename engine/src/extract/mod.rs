@@ -23,8 +23,7 @@ use glam::{DMat4, UVec2, Vec2, Vec3};
 use materials::NestedMaterials;
 use radiant_core::registry::ModuleType;
 use radiant_core::{
-    Frame,
-    BoundingSphere, BuildContext, Camera, Effects, EmitterShape, Filter, Light, ModuleKind,
+    BoundingSphere, BuildContext, Camera, Effects, EmitterShape, Filter, Frame, Light, ModuleKind,
     Registry, Sampler, Shader, Texture, TextureTable,
 };
 use shapes::{ShapePrim, tessellate};

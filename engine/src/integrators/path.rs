@@ -92,6 +92,8 @@ pub struct Wavefront {
     u3: Vec<Vec3>,
     bsdf: Vec<BsdfSample>,
     nee_wi: Vec<Vec3>,
+    /// `nee_wi` in world space.
+    nee_wi_world: Vec<Vec3>,
     nee_eval: Vec<BsdfEval>,
     light: Vec<u32>,
     light_prob: Vec<f32>,
@@ -445,9 +447,11 @@ impl Wavefront {
         }
         // Directions towards the light samples, in the local frames.
         fit(&mut self.nee_wi, n);
+        fit(&mut self.nee_wi_world, n);
         for k in 0..n {
             let it = &self.its[self.live[k] as usize];
             let wi = (self.light_sample[k].p - it.p).normalize_or_zero();
+            self.nee_wi_world[k] = wi;
             self.nee_wi[k] = it.frame.to_local(wi);
         }
     }
@@ -551,19 +555,20 @@ impl Wavefront {
             let slot = self.live[k];
             let i = slot as usize;
             let it = &self.its[i];
-            let wi = it.frame.to_world(self.nee_wi[k]);
+            let wi = self.nee_wi_world[k];
             // Shading and geometric normals must agree on the side.
             if wi.dot(it.ng) * self.nee_wi[k].z <= 0.0 {
                 continue;
             }
             let light_pdf = self.light_prob[k] * ls.pdf;
-            let delta = scene.lights.is_delta(self.light[k] as usize);
-            let w = if delta {
-                1.0
+            // The MIS weight over the density, w / light_pdf, in one
+            // division: 1/p for delta lights, p/(p² + bsdf²) otherwise.
+            let weight = if scene.lights.is_delta(self.light[k] as usize) {
+                1.0 / light_pdf
             } else {
-                power_heuristic(light_pdf, e.pdf)
+                light_pdf / (light_pdf * light_pdf + e.pdf * e.pdf)
             };
-            let value = self.beta[i] * e.value * ls.radiance * (w / light_pdf);
+            let value = self.beta[i] * e.value * ls.radiance * weight;
             if value == Rgb::ZERO || !value.is_finite() {
                 continue;
             }

@@ -34,8 +34,8 @@ const DOCS: &[ParamDoc] = &[ParamDoc {
 /// What next-event estimation samples as one unit.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Part {
-    /// A triangle, by area.
-    Triangle([Vec3; 3]),
+    /// A triangle, by area, with its unit normal (by winding).
+    Triangle([Vec3; 3], Vec3),
     /// Two triangles forming a rectangle, by solid angle where reliable.
     Rectangle(Rectangle),
     /// A sphere (centre, radius), by solid angle from outside.
@@ -45,7 +45,7 @@ enum Part {
 impl Part {
     fn area(&self) -> f64 {
         match *self {
-            Part::Triangle([a, b, c]) => 0.5 * (b - a).cross(c - a).length() as f64,
+            Part::Triangle([a, b, c], _) => 0.5 * (b - a).cross(c - a).length() as f64,
             Part::Rectangle(r) => r.area() as f64,
             Part::Sphere(_, r) => 4.0 * std::f64::consts::PI * (r as f64).powi(2),
         }
@@ -63,6 +63,8 @@ pub struct AreaLight {
     part_of: Vec<u32>,
     /// Cumulative areas of the parts.
     cdf: Vec<f32>,
+    /// Probability of picking each part (its share of the area).
+    probability: Vec<f32>,
     area: f32,
 }
 
@@ -85,7 +87,8 @@ impl AreaLight {
                     i += 2;
                 }
                 None => {
-                    parts.push(Part::Triangle(shape.triangles[i]));
+                    let [a, b, c] = shape.triangles[i];
+                    parts.push(Part::Triangle([a, b, c], (b - a).cross(c - a).normalize()));
                     i += 1;
                 }
             }
@@ -103,11 +106,13 @@ impl AreaLight {
         if !(total > 0.0 && total.is_finite()) {
             return Err("an area light needs a shape with a positive, finite surface area".into());
         }
+        let probability = parts.iter().map(|p| (p.area() / total) as f32).collect();
         Ok(Self {
             radiance,
             parts,
             part_of,
             cdf,
+            probability,
             area: total as f32,
         })
     }
@@ -116,6 +121,9 @@ impl AreaLight {
     /// rescaled to [0,1) for reuse.
     #[inline]
     fn pick(&self, u: f32) -> (usize, f32) {
+        if self.parts.len() == 1 {
+            return (0, u);
+        }
         let target = u * self.area;
         let i = self
             .cdf
@@ -134,8 +142,7 @@ impl AreaLight {
     /// Probability of picking part `part`.
     #[inline]
     fn part_probability(&self, part: usize) -> f32 {
-        let lo = if part == 0 { 0.0 } else { self.cdf[part - 1] };
-        (self.cdf[part] - lo) / self.area
+        self.probability[part]
     }
 
     /// A point on part `part` (with its normal) for `origin`, and the
@@ -143,10 +150,9 @@ impl AreaLight {
     #[inline]
     fn sample_part(&self, part: usize, origin: Vec3, u: Vec2) -> (Vec3, Vec3, f32) {
         let (p, n) = match self.parts[part] {
-            Part::Triangle([a, b, c]) => {
+            Part::Triangle([a, b, c], n) => {
                 let bary = square_to_uniform_triangle(u);
-                let p = a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y;
-                (p, (b - a).cross(c - a).normalize())
+                (a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y, n)
             }
             Part::Rectangle(rect) => match rect.spherical(origin) {
                 Some(s) => {
@@ -186,7 +192,7 @@ impl AreaLight {
                     return self.part_probability(part) / s.solid_angle;
                 }
             }
-            Part::Triangle(_) => {}
+            Part::Triangle(..) => {}
         }
         self.area_pdf(origin, p, n)
     }
@@ -195,11 +201,12 @@ impl AreaLight {
     /// its part is sampled by area; 0 if `p` faces away.
     #[inline]
     fn area_pdf(&self, origin: Vec3, p: Vec3, n: Vec3) -> f32 {
+        // dist² / (cos θ · area) with cos θ = n·d / dist: one division.
         let d = origin - p;
         let dist2 = d.length_squared();
-        let cos_l = n.dot(d) / dist2.sqrt();
-        if cos_l > 0.0 {
-            dist2 / (cos_l * self.area)
+        let n_dot_d = n.dot(d);
+        if n_dot_d > 0.0 {
+            dist2 * dist2.sqrt() / (n_dot_d * self.area)
         } else {
             0.0
         }
