@@ -3,7 +3,7 @@
 //! box never leak out, with no fixed epsilon anywhere.
 
 use glam::{Vec2, Vec3};
-use radiant::accel::offset::{offset_origin, triangle_error};
+use radiant::accel::offset::{offset_origin, triangle_point};
 use radiant::accel::{Accel, BuildQuality, Hit, Primitive};
 
 struct Lcg(u64);
@@ -51,9 +51,9 @@ fn surface(accel: &Accel, hit: &Hit) -> (Vec3, Vec3, Vec3) {
         panic!("expected a triangle")
     };
     let b0 = 1.0 - hit.b1 - hit.b2;
-    let p = v[0] * b0 + v[1] * hit.b1 + v[2] * hit.b2;
+    let (p, err) = triangle_point(&v, b0, hit.b1, hit.b2);
     let n = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
-    (p, triangle_error(&v, b0, hit.b1, hit.b2), n)
+    (p, err, n)
 }
 
 /// Random walks inside a closed cube, leaving each hit in a cosine-weighted

@@ -13,11 +13,17 @@ fn gamma(n: i32) -> f32 {
     (n as f32 * e) / (1.0 - n as f32 * e)
 }
 
-/// Error bound of a point interpolated from triangle vertices `v` with
-/// barycentrics (b0, b1, b2).
+/// The point of triangle `v` with barycentrics (b0, b1, b2) and the bound
+/// on its floating-point error, which shares the products of the point.
 #[inline]
-pub fn triangle_error(v: &[Vec3; 3], b0: f32, b1: f32, b2: f32) -> Vec3 {
-    ((v[0] * b0).abs() + (v[1] * b1).abs() + (v[2] * b2).abs()) * gamma(7)
+pub fn triangle_point(v: &[Vec3; 3], b0: f32, b1: f32, b2: f32) -> (Vec3, Vec3) {
+    let [w0, w1, w2] = [
+        Vec3A::from(v[0]) * b0,
+        Vec3A::from(v[1]) * b1,
+        Vec3A::from(v[2]) * b2,
+    ];
+    let err = (w0.abs() + w1.abs() + w2.abs()) * gamma(7);
+    (Vec3::from(w0 + w1 + w2), Vec3::from(err))
 }
 
 /// Error bound of a point re-projected onto a sphere.
@@ -69,8 +75,7 @@ mod tests {
             ];
             let n = Vec3::Z;
             let (b0, b1, b2) = (0.2, 0.3, 0.5);
-            let p = v[0] * b0 + v[1] * b1 + v[2] * b2;
-            let err = triangle_error(&v, b0, b1, b2);
+            let (p, err) = triangle_point(&v, b0, b1, b2);
             let up = offset_origin(p, err, n, Vec3::new(0.0, 0.3, 1.0));
             let down = offset_origin(p, err, n, Vec3::new(0.0, 0.3, -1.0));
             assert!(up.z > v[0].z && down.z < v[0].z, "scale {scale}");

@@ -328,7 +328,7 @@ mod tests {
 
     #[test]
     fn hits_within_the_error_bound_of_zero_are_decided_exactly() {
-        use crate::accel::offset::{offset_origin, triangle_error};
+        use crate::accel::offset::{offset_origin, triangle_point};
         // The floor y = 0 and the wall x = 1 of a box, meeting at an edge
         // (normals into the box). Rays leave the floor just next to the
         // edge, heading into the wall; they must hit it, and never the
@@ -357,9 +357,9 @@ mod tests {
             let (b1, b2) = (0.5 + z * 0.5 - gap * 0.5, 0.5 - z * 0.5 - gap * 0.5);
             let tri = floor[0];
             let b0 = 1.0 - b1 - b2;
-            let p = tri[0] * b0 + tri[1] * b1 + tri[2] * b2;
+            let (p, err) = triangle_point(&tri, b0, b1, b2);
             let dir = Vec3::new(0.1 + (i % 7) as f32 * 0.1, 1.0, 0.3).normalize();
-            let origin = offset_origin(p, triangle_error(&tri, b0, b1, b2), Vec3::Y, dir);
+            let origin = offset_origin(p, err, Vec3::Y, dir);
             if origin.x >= 1.0 {
                 continue; // rounded onto the wall: not inside the box
             }

@@ -1,6 +1,6 @@
 //! Surface interactions: what the shading stages need to know about a hit.
 
-use crate::accel::offset::{sphere_error, triangle_error};
+use crate::accel::offset::{sphere_error, triangle_point};
 use crate::accel::{Hit, Primitive};
 use crate::extract::RenderScene;
 use glam::{Vec2, Vec3};
@@ -47,7 +47,7 @@ pub fn interaction(scene: &RenderScene, hit: &Hit, origin: Vec3, dir: Vec3) -> I
     match scene.accel.primitives()[i] {
         Primitive::Triangle(v) => {
             let b0 = 1.0 - hit.b1 - hit.b2;
-            let p = v[0] * b0 + v[1] * hit.b1 + v[2] * hit.b2;
+            let (p, err) = triangle_point(&v, b0, hit.b1, hit.b2);
             let face = scene.surfaces.face_frames[i];
             let ng = face.n;
             let n = scene.surfaces.normals[i];
@@ -64,7 +64,7 @@ pub fn interaction(scene: &RenderScene, hit: &Hit, origin: Vec3, dir: Vec3) -> I
             let uv = scene.surfaces.uvs[i];
             Interaction {
                 p,
-                err: triangle_error(&v, b0, hit.b1, hit.b2),
+                err,
                 ng,
                 frame,
                 uv: uv[0] * b0 + uv[1] * hit.b1 + uv[2] * hit.b2,
