@@ -177,7 +177,7 @@ fn csv_plot_and_summary_are_written_and_parse() {
             "filter=mitchell",
             "filter=tent",
             "bvh=fast",
-            "bvh=high"
+            "bvh=medium"
         ]
     );
 

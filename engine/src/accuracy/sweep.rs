@@ -226,7 +226,7 @@ pub fn settings(scene: &Scene, registry: &Registry, axes: &[Axis]) -> (Vec<Setti
                     .map(Change::LightSelection)
                     .collect()
             }
-            Axis::Bvh => [BuildQuality::Fast, BuildQuality::High]
+            Axis::Bvh => [BuildQuality::Fast, BuildQuality::Medium]
                 .into_iter()
                 .map(Change::Bvh)
                 .collect(),
@@ -381,7 +381,7 @@ mod tests {
                 "sampler=sobol",
                 "sampler=stratified",
                 "bvh=fast",
-                "bvh=high"
+                "bvh=medium"
             ]
         );
         assert!(notes.iter().any(|n| n.starts_with("light_selection")));

@@ -45,7 +45,8 @@ pub struct Overrides {
     pub height: Option<u32>,
     /// Light selection of next-event estimation.
     pub light_selection: Option<LightSelection>,
-    /// BVH build quality (default: [`BuildQuality::Medium`]).
+    /// BVH build quality (default: [`BuildQuality::default_for`] the
+    /// scene's primitive count).
     pub bvh: Option<BuildQuality>,
 }
 
@@ -300,7 +301,12 @@ pub fn extract(
             ShapePrim::Sphere { centre, radius } => Primitive::Sphere(centre, radius),
         })
         .collect();
-    let (accel, order) = Accel::build(&geometric, overrides.bvh.unwrap_or_default());
+    let (accel, order) = Accel::build(
+        &geometric,
+        overrides
+            .bvh
+            .unwrap_or_else(|| BuildQuality::default_for(geometric.len())),
+    );
     stats.bvh_build = accel.build_time;
     let mut surfaces = Surfaces::default();
     for &i in &order {
