@@ -124,6 +124,8 @@ pub(crate) fn register(registry: &mut Registry) {
 
 #[cfg(test)]
 mod tests {
+    // `unwrap` in this test code is the assertion: the inputs are the test's
+    // own, so a failure is a bug, and the panic reports it with the error.
     use super::*;
     use radiant_core::params::check_param_docs;
 
