@@ -20,9 +20,10 @@ mod wide;
 use glam::{Vec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
+use std::ops::Range;
 use std::time::Duration;
 use triangle::{RayPrep, Tri4};
-use wide::{RayBoxes, WideBvh};
+use wide::{Avx2, Baseline, Isa, LeafVisitor, RayBoxes, WideBvh};
 
 /// A primitive as the intersector sees it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -65,6 +66,17 @@ pub struct Hit {
     pub b1: f32,
     /// See `b1`.
     pub b2: f32,
+}
+
+impl Hit {
+    /// What a ray that hits nothing gets from batch queries: `t` infinite,
+    /// `prim` `u32::MAX`.
+    pub const MISS: Hit = Hit {
+        t: f32::INFINITY,
+        prim: u32::MAX,
+        b1: 0.0,
+        b2: 0.0,
+    };
 }
 
 /// BVH quality preset.
@@ -125,6 +137,8 @@ pub struct Accel {
     bvh: WideBvh,
     packets: Vec<Packet>,
     prims: Vec<Primitive>,
+    /// Whether queries run the AVX2 traversal (the CPU has AVX2).
+    avx2: bool,
     /// Time the build took.
     pub build_time: Duration,
 }
@@ -188,6 +202,7 @@ impl Accel {
             bvh,
             packets,
             prims: ordered,
+            avx2: Avx2::detected(),
             build_time: start.elapsed(),
         };
         (accel, order)
@@ -201,64 +216,236 @@ impl Accel {
     /// Finds the closest hit along `origin + t·dir` for `t` in (0, `tmax`).
     #[inline]
     pub fn intersect(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Option<Hit> {
-        if self.bvh.is_empty() || !ray_is_valid(origin, dir, tmax) {
-            return None;
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where the CPU supports AVX2.
+            return unsafe { self.intersect_avx2(origin, dir, tmax) };
         }
-        let prep = RayPrep::new(origin, dir);
-        let prep = &prep;
-        let mut best = None;
-        self.bvh
-            .closest(&RayBoxes::new(origin, dir), tmax, |range, mut tmax| {
-                for packet in &self.packets[range] {
-                    match *packet {
-                        Packet::Triangles { ref tris, first } => {
-                            if let Some(h) = tris.closest(prep, tmax) {
-                                tmax = h.t;
-                                best = Some(Hit {
-                                    t: h.t,
-                                    prim: first + h.lane as u32,
-                                    b1: h.b1,
-                                    b2: h.b2,
-                                });
-                            }
-                        }
-                        Packet::Sphere {
-                            centre,
-                            radius,
-                            prim,
-                        } => {
-                            if let Some(t) = hit_sphere(origin, dir, centre, radius, tmax) {
-                                tmax = t;
-                                best = Some(Hit {
-                                    t,
-                                    prim,
-                                    b1: 0.0,
-                                    b2: 0.0,
-                                });
-                            }
-                        }
-                    }
-                }
-                tmax
-            });
-        best
+        self.intersect_with::<Baseline>(origin, dir, tmax)
     }
 
     /// Whether anything blocks `origin + t·dir` for `t` in (0, `tmax`).
     #[inline]
     pub fn occluded(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where the CPU supports AVX2.
+            return unsafe { self.occluded_avx2(origin, dir, tmax) };
+        }
+        self.occluded_with::<Baseline>(origin, dir, tmax)
+    }
+
+    /// Closest hits of a batch of rays: for each `slot` in `slots`, the ray
+    /// `origins[slot] + t·dirs[slot]`, t in (0, ∞), gets its hit in
+    /// `hits[slot]` ([`Hit::MISS`] if it hits nothing). The instruction
+    /// set is chosen once for the batch and the loop compiled for it.
+    ///
+    /// # Panics
+    ///
+    /// If a slot is out of bounds of `origins`, `dirs` or `hits`.
+    pub fn intersect_slots(
+        &self,
+        slots: &[u32],
+        origins: &[Vec3],
+        dirs: &[Vec3],
+        hits: &mut [Hit],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where the CPU supports AVX2.
+            return unsafe { self.intersect_slots_avx2(slots, origins, dirs, hits) };
+        }
+        self.intersect_slots_with::<Baseline>(slots, origins, dirs, hits);
+    }
+
+    /// For a batch of shadow rays `origins[j] + t·dirs[j]`, t in
+    /// (0, `tmax`): whether anything blocks ray `j`, in `blocked[j]`. The
+    /// instruction set is chosen once for the batch.
+    ///
+    /// # Panics
+    ///
+    /// If the three slices differ in length.
+    pub fn occluded_each(&self, origins: &[Vec3], dirs: &[Vec3], tmax: f32, blocked: &mut [bool]) {
+        assert!(origins.len() == dirs.len() && dirs.len() == blocked.len());
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where the CPU supports AVX2.
+            return unsafe { self.occluded_each_avx2(origins, dirs, tmax, blocked) };
+        }
+        self.occluded_each_with::<Baseline>(origins, dirs, tmax, blocked);
+    }
+
+    /// [`Self::intersect`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn intersect_avx2(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Option<Hit> {
+        self.intersect_with::<Avx2>(origin, dir, tmax)
+    }
+
+    /// [`Self::occluded`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn occluded_avx2(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+        self.occluded_with::<Avx2>(origin, dir, tmax)
+    }
+
+    /// [`Self::intersect_slots`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn intersect_slots_avx2(
+        &self,
+        slots: &[u32],
+        origins: &[Vec3],
+        dirs: &[Vec3],
+        hits: &mut [Hit],
+    ) {
+        self.intersect_slots_with::<Avx2>(slots, origins, dirs, hits);
+    }
+
+    /// [`Self::occluded_each`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn occluded_each_avx2(&self, origins: &[Vec3], dirs: &[Vec3], tmax: f32, blocked: &mut [bool]) {
+        self.occluded_each_with::<Avx2>(origins, dirs, tmax, blocked);
+    }
+
+    /// [`Self::intersect_slots`] with the instruction set `I`.
+    #[inline(always)]
+    fn intersect_slots_with<I: Isa>(
+        &self,
+        slots: &[u32],
+        origins: &[Vec3],
+        dirs: &[Vec3],
+        hits: &mut [Hit],
+    ) {
+        for &slot in slots {
+            let i = slot as usize;
+            hits[i] = self
+                .intersect_with::<I>(origins[i], dirs[i], f32::INFINITY)
+                .unwrap_or(Hit::MISS);
+        }
+    }
+
+    /// [`Self::occluded_each`] with the instruction set `I`.
+    #[inline(always)]
+    fn occluded_each_with<I: Isa>(
+        &self,
+        origins: &[Vec3],
+        dirs: &[Vec3],
+        tmax: f32,
+        blocked: &mut [bool],
+    ) {
+        for ((b, &o), &d) in blocked.iter_mut().zip(origins).zip(dirs) {
+            *b = self.occluded_with::<I>(o, d, tmax);
+        }
+    }
+
+    /// Queries run the baseline traversal from now on, whatever the CPU
+    /// supports (to test it against the AVX2 one).
+    #[cfg(test)]
+    fn use_baseline(&mut self) {
+        self.avx2 = false;
+    }
+
+    /// [`Self::intersect`] with the instruction set `I`.
+    #[inline(always)]
+    fn intersect_with<I: Isa>(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Option<Hit> {
+        if self.bvh.is_empty() || !ray_is_valid(origin, dir, tmax) {
+            return None;
+        }
+        let prep = RayPrep::new(origin, dir);
+        let mut query = Query::new(&self.packets, origin, dir, &prep);
+        self.bvh
+            .closest::<I>(&RayBoxes::new(origin, dir), tmax, &mut query);
+        query.best
+    }
+
+    /// [`Self::occluded`] with the instruction set `I`.
+    #[inline(always)]
+    fn occluded_with<I: Isa>(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
         if self.bvh.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return false;
         }
-        let prep = &RayPrep::new(origin, dir);
-        self.bvh.any(&RayBoxes::new(origin, dir), tmax, |range| {
-            self.packets[range].iter().any(|packet| match *packet {
-                Packet::Triangles { ref tris, .. } => tris.any(prep, tmax),
-                Packet::Sphere { centre, radius, .. } => {
-                    hit_sphere(origin, dir, centre, radius, tmax).is_some()
+        let prep = RayPrep::new(origin, dir);
+        let mut query = Query::new(&self.packets, origin, dir, &prep);
+        self.bvh
+            .any::<I>(&RayBoxes::new(origin, dir), tmax, &mut query)
+    }
+}
+
+/// One ray's query at the leaves: its packets, its per-ray constants and
+/// the closest hit so far.
+struct Query<'a> {
+    packets: &'a [Packet],
+    origin: Vec3,
+    dir: Vec3,
+    prep: &'a RayPrep,
+    best: Option<Hit>,
+}
+
+impl<'a> Query<'a> {
+    #[inline(always)]
+    fn new(packets: &'a [Packet], origin: Vec3, dir: Vec3, prep: &'a RayPrep) -> Self {
+        Self {
+            packets,
+            origin,
+            dir,
+            prep,
+            best: None,
+        }
+    }
+}
+
+impl LeafVisitor for Query<'_> {
+    #[inline(always)]
+    fn closest(&mut self, range: Range<usize>, mut tmax: f32) -> f32 {
+        for packet in &self.packets[range] {
+            match *packet {
+                Packet::Triangles { ref tris, first } => {
+                    if let Some(h) = tris.closest(self.prep, tmax) {
+                        tmax = h.t;
+                        self.best = Some(Hit {
+                            t: h.t,
+                            prim: first + h.lane as u32,
+                            b1: h.b1,
+                            b2: h.b2,
+                        });
+                    }
                 }
-            })
-        })
+                Packet::Sphere {
+                    centre,
+                    radius,
+                    prim,
+                } => {
+                    if let Some(t) = hit_sphere(self.origin, self.dir, centre, radius, tmax) {
+                        tmax = t;
+                        self.best = Some(Hit {
+                            t,
+                            prim,
+                            b1: 0.0,
+                            b2: 0.0,
+                        });
+                    }
+                }
+            }
+        }
+        tmax
+    }
+
+    #[inline(always)]
+    fn any(&mut self, range: Range<usize>, tmax: f32) -> bool {
+        for packet in &self.packets[range] {
+            let hit = match *packet {
+                Packet::Triangles { ref tris, .. } => tris.any(self.prep, tmax),
+                Packet::Sphere { centre, radius, .. } => {
+                    hit_sphere(self.origin, self.dir, centre, radius, tmax).is_some()
+                }
+            };
+            if hit {
+                return true;
+            }
+        }
+        false
     }
 }
 
@@ -320,6 +507,9 @@ mod tests {
                 }
             }
             let (accel, order) = Accel::build(&prims, BuildQuality::Medium);
+            // Both instruction sets (the same one twice without AVX2).
+            let mut baseline = Accel::build(&prims, BuildQuality::Medium).0;
+            baseline.use_baseline();
             for _ in 0..2000 {
                 let o = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 16.0 - 8.0;
                 let d = (Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) - 0.5).normalize();
@@ -339,6 +529,10 @@ mod tests {
                 assert_eq!(accel.occluded(o, d, f32::INFINITY), expected.is_some());
                 if let Some((t, _)) = expected {
                     assert!(!accel.occluded(o, d, t * 0.999));
+                }
+                assert_eq!(baseline.intersect(o, d, f32::INFINITY), got);
+                for tmax in [f32::INFINITY, got.map_or(1.0, |h| h.t * 0.999)] {
+                    assert_eq!(baseline.occluded(o, d, tmax), accel.occluded(o, d, tmax));
                 }
             }
         }

@@ -3,9 +3,10 @@
 //! obvhs builds a binary BVH (PLOC with reinsertion and SAH leaf
 //! collapsing); [`WideBvh::build`] collapses it into nodes of up to eight
 //! children whose boxes are stored structure-of-arrays, so that one node is
-//! tested against a ray with SIMD, four lanes at a time (glam's `Vec4`: SSE
-//! on x86_64, a scalar fallback elsewhere). A leaf is a range of items
-//! (packets of primitives) that the caller stores.
+//! tested against a ray with SIMD: all eight lanes at once with AVX where
+//! the CPU has AVX2 (detected at run time, [`Isa`]), else four at a time
+//! (glam's `Vec4`: SSE on x86_64, a scalar fallback elsewhere). A leaf is a
+//! range of items (packets of primitives) that the caller stores.
 //!
 //! Traversal intersects a node's leaves as soon as the node is visited and
 //! keeps only inner nodes on its stack, so each step is one box test and no
@@ -151,6 +152,49 @@ impl Stack {
     }
 }
 
+/// The instruction set a traversal is compiled for, as a type parameter,
+/// so that one generic traversal serves every set.
+///
+/// Sealed: [`Avx2`] may only be used inside functions compiled with
+/// `#[target_feature(enable = "avx2")]`, which in turn are only called once
+/// the CPU was seen to support it ([`Avx2::detected`]).
+pub trait Isa: sealed::Sealed {
+    /// Whether the box test may use 256-bit AVX instructions.
+    const AVX2: bool;
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for super::Baseline {}
+    impl Sealed for super::Avx2 {}
+}
+
+/// The target's baseline: SSE2 on x86_64, portable code elsewhere.
+#[derive(Debug, Clone, Copy)]
+pub struct Baseline;
+
+impl Isa for Baseline {
+    const AVX2: bool = false;
+}
+
+/// AVX2 (x86_64 CPUs since 2013): eight lanes per instruction.
+#[derive(Debug, Clone, Copy)]
+pub struct Avx2;
+
+impl Isa for Avx2 {
+    const AVX2: bool = true;
+}
+
+impl Avx2 {
+    /// Whether this CPU supports AVX2.
+    pub fn detected() -> bool {
+        #[cfg(target_arch = "x86_64")]
+        return std::arch::is_x86_feature_detected!("avx2");
+        #[cfg(not(target_arch = "x86_64"))]
+        return false;
+    }
+}
+
 /// Per-ray constants of the box test.
 #[derive(Debug, Clone, Copy)]
 pub struct RayBoxes {
@@ -179,7 +223,51 @@ impl RayBoxes {
     /// Which children of `node` the ray meets for t in (0, `tmax`): a bit
     /// mask, and the distances at which it enters their boxes.
     #[inline(always)]
-    fn test(&self, node: &Node, tmax: f32) -> (u32, [f32; WIDTH]) {
+    fn test<I: Isa>(&self, node: &Node, tmax: f32) -> (u32, [f32; WIDTH]) {
+        #[cfg(target_arch = "x86_64")]
+        if I::AVX2 {
+            // SAFETY: `Avx2` traversals run only on CPUs with AVX2 (`Isa`).
+            return unsafe { self.test_avx(node, tmax) };
+        }
+        self.test_sse(node, tmax)
+    }
+
+    /// [`Self::test`] with 256-bit AVX: the same operations, in the same
+    /// order, on all eight lanes at once (so the same results).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn test_avx(&self, node: &Node, tmax: f32) -> (u32, [f32; WIDTH]) {
+        use std::arch::x86_64::*;
+        let mut t_near = _mm256_setzero_ps();
+        let mut t_far = _mm256_set1_ps(tmax);
+        for axis in 0..3 {
+            let near = self.near[axis] & 1;
+            let origin = _mm256_set1_ps(self.origin[axis].x);
+            let inv_dir = _mm256_set1_ps(self.inv_dir[axis].x);
+            let bounds = |side: usize| {
+                // SAFETY: a group pair is eight contiguous f32 in a 64-byte
+                // aligned node, at a multiple of 32 bytes (an aligned load).
+                unsafe { _mm256_load_ps(node.bounds[side][axis].as_ptr().cast()) }
+            };
+            let lo = _mm256_mul_ps(_mm256_sub_ps(bounds(near), origin), inv_dir);
+            let hi = _mm256_mul_ps(_mm256_sub_ps(bounds(near ^ 1), origin), inv_dir);
+            // MAXPS/MINPS keep the second operand where the first is NaN,
+            // as `max_of` and `min_of` do.
+            t_near = _mm256_max_ps(lo, t_near);
+            t_far = _mm256_min_ps(hi, t_far);
+        }
+        let far = _mm256_mul_ps(t_far, _mm256_set1_ps(FAR_SCALE));
+        let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, far)) as u32;
+        let mut t = [0.0; WIDTH];
+        // SAFETY: `t` holds eight f32.
+        unsafe { _mm256_storeu_ps(t.as_mut_ptr(), t_near) };
+        (mask, t)
+    }
+
+    /// [`Self::test`] four lanes at a time.
+    #[inline(always)]
+    fn test_sse(&self, node: &Node, tmax: f32) -> (u32, [f32; WIDTH]) {
         let mut mask = 0;
         let mut t = [0.0; WIDTH];
         for g in 0..GROUPS {
@@ -216,6 +304,19 @@ fn min_of(new: Vec4, acc: Vec4) -> Vec4 {
     return new.min(acc);
     #[cfg(not(any(target_arch = "x86", target_arch = "x86_64")))]
     return Vec4::select(new.cmplt(acc), new, acc);
+}
+
+/// What traversal does at a leaf: intersects the leaf's items (a range
+/// of the caller's storage) with the ray. Implementations mark their
+/// methods `#[inline(always)]`, so that they compile into the traversal
+/// with its instruction set (a closure might stay a call).
+pub trait LeafVisitor {
+    /// Intersects items `range` for the closest hit within `tmax`; returns
+    /// the new `tmax` (the closest hit so far).
+    fn closest(&mut self, range: Range<usize>, tmax: f32) -> f32;
+
+    /// Whether any item of `range` is hit within `tmax`.
+    fn any(&mut self, range: Range<usize>, tmax: f32) -> bool;
 }
 
 /// A wide BVH; its leaves are ranges of items stored elsewhere.
@@ -277,15 +378,10 @@ impl WideBvh {
     }
 
     /// Visits the leaves that `ray` may hit in (0, `tmax`), inner nodes
-    /// nearest first. `leaf` intersects a leaf's items and returns the new
-    /// `tmax` (the closest hit so far); boxes beyond it are skipped.
+    /// nearest first, with [`LeafVisitor::closest`]; boxes beyond the
+    /// closest hit so far are skipped.
     #[inline(always)]
-    pub fn closest(
-        &self,
-        ray: &RayBoxes,
-        mut tmax: f32,
-        mut leaf: impl FnMut(Range<usize>, f32) -> f32,
-    ) {
+    pub fn closest<I: Isa>(&self, ray: &RayBoxes, mut tmax: f32, leaf: &mut impl LeafVisitor) {
         if self.nodes.is_empty() {
             return;
         }
@@ -293,7 +389,7 @@ impl WideBvh {
         let mut current = 0;
         loop {
             let node = &self.nodes[current];
-            let (mask, t_near) = ray.test(node, tmax);
+            let (mask, t_near) = ray.test::<I>(node, tmax);
             // Leaves nearest first, until the next one starts beyond the hit.
             let mut leaves = mask & node.leaves;
             while leaves != 0 {
@@ -310,7 +406,7 @@ impl WideBvh {
                     break;
                 }
                 leaves &= !(1 << lane);
-                tmax = leaf(node.items(lane), tmax);
+                tmax = leaf.closest(node.items(lane), tmax);
             }
             stack.push_lanes(node, mask & !node.leaves, &t_near, true);
             // Next: the nearest pending node that is not beyond the hit.
@@ -324,16 +420,10 @@ impl WideBvh {
         }
     }
 
-    /// Visits the leaves that `ray` may hit in (0, `tmax`) until `leaf`
-    /// (which intersects a leaf's items) reports a hit; returns whether one
-    /// did.
+    /// Visits the leaves that `ray` may hit in (0, `tmax`) until
+    /// [`LeafVisitor::any`] reports a hit; returns whether one did.
     #[inline(always)]
-    pub fn any(
-        &self,
-        ray: &RayBoxes,
-        tmax: f32,
-        mut leaf: impl FnMut(Range<usize>) -> bool,
-    ) -> bool {
+    pub fn any<I: Isa>(&self, ray: &RayBoxes, tmax: f32, leaf: &mut impl LeafVisitor) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
@@ -341,12 +431,12 @@ impl WideBvh {
         let mut current = 0;
         loop {
             let node = &self.nodes[current];
-            let (mask, t_near) = ray.test(node, tmax);
+            let (mask, t_near) = ray.test::<I>(node, tmax);
             let mut leaves = mask & node.leaves;
             while leaves != 0 {
                 let lane = leaves.trailing_zeros() as usize;
                 leaves &= leaves - 1;
-                if leaf(node.items(lane)) {
+                if leaf.any(node.items(lane), tmax) {
                     return true;
                 }
             }

@@ -117,6 +117,8 @@ pub struct Wavefront {
     shadow_origin: Vec<Vec3>,
     shadow_dir: Vec<Vec3>,
     shadow_value: Vec<Rgb>,
+    /// Per shadow ray: whether something blocks it.
+    shadow_blocked: Vec<bool>,
     /// Rays traced so far (camera, continuation and shadow rays).
     pub rays: u64,
 }
@@ -294,18 +296,9 @@ impl Wavefront {
     }
 
     fn trace_closest(&mut self, scene: &RenderScene) {
-        for &slot in &self.live {
-            let i = slot as usize;
-            self.hit[i] = scene
-                .accel
-                .intersect(self.origin[i], self.dir[i], f32::INFINITY)
-                .unwrap_or(Hit {
-                    t: f32::INFINITY,
-                    prim: u32::MAX,
-                    b1: 0.0,
-                    b2: 0.0,
-                });
-        }
+        scene
+            .accel
+            .intersect_slots(&self.live, &self.origin, &self.dir, &mut self.hit);
         self.rays += self.live.len() as u64;
     }
 
@@ -318,7 +311,7 @@ impl Wavefront {
         for &slot in &self.live {
             let i = slot as usize;
             let hit = self.hit[i];
-            if hit.prim == u32::MAX {
+            if hit.prim == Hit::MISS.prim {
                 if has_env {
                     self.esc_slots.push(slot);
                 }
@@ -583,13 +576,16 @@ impl Wavefront {
             self.shadow_dir.push(target - origin);
             self.shadow_value.push(value);
         }
-        for j in 0..self.shadow_slot.len() {
-            if !scene.accel.occluded(
-                self.shadow_origin[j],
-                self.shadow_dir[j],
-                1.0 - SHADOW_EPSILON,
-            ) {
-                self.radiance[self.shadow_slot[j] as usize] += self.shadow_value[j];
+        fit(&mut self.shadow_blocked, self.shadow_slot.len());
+        scene.accel.occluded_each(
+            &self.shadow_origin,
+            &self.shadow_dir,
+            1.0 - SHADOW_EPSILON,
+            &mut self.shadow_blocked,
+        );
+        for (j, &slot) in self.shadow_slot.iter().enumerate() {
+            if !self.shadow_blocked[j] {
+                self.radiance[slot as usize] += self.shadow_value[j];
             }
         }
         self.rays += self.shadow_slot.len() as u64;

@@ -20,10 +20,30 @@ pub fn hash_u32(mut x: u32) -> u32 {
 /// Hashes four words into one, order-sensitively.
 #[inline]
 pub fn hash4(a: u32, b: u32, c: u32, d: u32) -> u32 {
-    let h = hash_u32(a ^ 0x9e37_79b9);
-    let h = hash_u32(h ^ b);
-    let h = hash_u32(h ^ c.wrapping_mul(0x85eb_ca6b));
-    hash_u32(h ^ d.wrapping_mul(0xc2b2_ae35))
+    hash4_last(hash4_middle(hash4_first(a), b, c), d)
+}
+
+/// The first stage of [`hash4`]: the state after word `a`. Callers that
+/// hash many tuples with the same first word (a seed) compute it once.
+#[inline]
+pub fn hash4_first(a: u32) -> u32 {
+    hash_u32(a ^ 0x9e37_79b9)
+}
+
+/// The middle stage of [`hash4`]: the state after words `b` and `c`,
+/// from the state [`hash4_first`] returned.
+#[inline]
+pub fn hash4_middle(state: u32, b: u32, c: u32) -> u32 {
+    let h = hash_u32(state ^ b);
+    hash_u32(h ^ c.wrapping_mul(0x85eb_ca6b))
+}
+
+/// The last stage of [`hash4`]: the hash of the tuple ending in word `d`,
+/// from the state [`hash4_middle`] returned. A sample's dimensions share
+/// everything up to here.
+#[inline]
+pub fn hash4_last(state: u32, d: u32) -> u32 {
+    hash_u32(state ^ d.wrapping_mul(0xc2b2_ae35))
 }
 
 /// Maps 32 random bits to a float uniformly distributed in [0, 1).
@@ -47,6 +67,17 @@ mod tests {
     fn unit_float_is_in_range() {
         assert_eq!(unit_float(0), 0.0);
         assert!(unit_float(u32::MAX) < 1.0);
+    }
+
+    #[test]
+    fn staged_hash_is_hash4() {
+        for (a, b, c, d) in [(0, 0, 0, 0), (7, 1, 2, 3), (u32::MAX, 9, 0, 12345)] {
+            let staged = hash4_last(hash4_middle(hash4_first(a), b, c), d);
+            assert_eq!(staged, hash4(a, b, c, d));
+        }
+        // Word order matters.
+        assert_ne!(hash4(1, 2, 3, 4), hash4(2, 1, 3, 4));
+        assert_ne!(hash4(1, 2, 3, 4), hash4(1, 2, 4, 3));
     }
 
     #[test]
