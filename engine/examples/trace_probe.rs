@@ -1,6 +1,7 @@
 //! Micro-benchmark of the ray-tracing core ([`radiant::accel`]): nanoseconds
-//! per closest-hit ray (`Accel::intersect`) and per shadow ray
-//! (`Accel::occluded`), single-threaded.
+//! per closest-hit ray and per shadow ray, single-threaded, traced in
+//! batches as the renderer traces them (`Accel::intersect_slots`,
+//! `Accel::occluded_each`).
 //!
 //! * Cornell box (`scenes/cornell-box.yaml`, 36 triangles): rays start at
 //!   random points inside the box and go in random directions; shadow rays
@@ -18,7 +19,7 @@
 
 use anyhow::{Context, Result};
 use glam::Vec3;
-use radiant::accel::{Accel, BuildQuality, Primitive};
+use radiant::accel::{Accel, BuildQuality, Hit, Primitive};
 use radiant::extract::{Overrides, extract};
 use std::hint::black_box;
 use std::path::Path;
@@ -59,24 +60,30 @@ impl Lcg {
     }
 }
 
-/// Times `accel` on closest-hit rays `closest` and shadow rays `shadow`.
+/// Times `accel` on closest-hit rays `closest` and shadow rays `shadow`,
+/// as the renderer traces them: in batches ([`Accel::intersect_slots`],
+/// [`Accel::occluded_each`]).
 fn measure(name: &str, accel: &Accel, closest: &[Query], shadow: &[Query]) {
+    let origins: Vec<Vec3> = closest.iter().map(|q| q.0).collect();
+    let dirs: Vec<Vec3> = closest.iter().map(|q| q.1).collect();
+    let slots: Vec<u32> = (0..closest.len() as u32).collect();
+    let mut hit = vec![Hit::MISS; closest.len()];
+    // Shadow rays as the renderer spawns them: the direction spans the
+    // segment, which ends at t = 1.
+    let shadow_origins: Vec<Vec3> = shadow.iter().map(|q| q.0).collect();
+    let shadow_dirs: Vec<Vec3> = shadow.iter().map(|q| q.1 * q.2).collect();
+    let mut is_blocked = vec![false; shadow.len()];
     let mut best = [f64::INFINITY; 2];
-    let (mut hits, mut blocked) = (0, 0);
     for _ in 0..PASSES {
         let start = Instant::now();
-        hits = closest
-            .iter()
-            .filter(|&&(o, d, t)| accel.intersect(black_box(o), d, t).is_some())
-            .count();
+        accel.intersect_slots(&slots, black_box(&origins), &dirs, &mut hit);
         best[0] = best[0].min(start.elapsed().as_secs_f64());
         let start = Instant::now();
-        blocked = shadow
-            .iter()
-            .filter(|&&(o, d, t)| accel.occluded(black_box(o), d, t))
-            .count();
+        accel.occluded_each(black_box(&shadow_origins), &shadow_dirs, 1.0, &mut is_blocked);
         best[1] = best[1].min(start.elapsed().as_secs_f64());
     }
+    let hits = hit.iter().filter(|h| h.prim != Hit::MISS.prim).count();
+    let blocked = is_blocked.iter().filter(|&&b| b).count();
     let ns = |s: f64, n: usize| s / n as f64 * 1e9;
     println!(
         "{name}: {} primitives, built in {:.1} ms",
