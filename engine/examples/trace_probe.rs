@@ -79,7 +79,12 @@ fn measure(name: &str, accel: &Accel, closest: &[Query], shadow: &[Query]) {
         accel.intersect_slots(&slots, black_box(&origins), &dirs, &mut hit);
         best[0] = best[0].min(start.elapsed().as_secs_f64());
         let start = Instant::now();
-        accel.occluded_each(black_box(&shadow_origins), &shadow_dirs, 1.0, &mut is_blocked);
+        accel.occluded_each(
+            black_box(&shadow_origins),
+            &shadow_dirs,
+            1.0,
+            &mut is_blocked,
+        );
         best[1] = best[1].min(start.elapsed().as_secs_f64());
     }
     let hits = hit.iter().filter(|h| h.prim != Hit::MISS.prim).count();
@@ -127,7 +132,7 @@ fn mesh(path: &Path, rng: &mut Lcg) -> Result<()> {
         .iter()
         .map(|t| Primitive::Triangle(t.map(|i| mesh.positions[i as usize])))
         .collect();
-    let (accel, _) = Accel::build(&prims, BuildQuality::Medium);
+    let (accel, _) = Accel::build(&prims, BuildQuality::default_for(prims.len()));
     let (lo, hi) = mesh
         .positions
         .iter()

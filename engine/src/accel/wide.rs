@@ -51,11 +51,13 @@ struct Node {
     bounds: [[[Vec4; GROUPS]; 3]; 2],
     /// Per child: a node index, or the first item of a leaf.
     child: [u32; WIDTH],
-    /// Per child: the number of items of a leaf (unused for nodes).
+    /// Per child: the number of items of a leaf (at least one), 0 for a
+    /// node or an unused lane. (No separate leaf mask: without one a node
+    /// is 256 bytes, four cache lines instead of five.)
     count: [u32; WIDTH],
-    /// Bit `lane` is set where the child is a leaf.
-    leaves: u32,
 }
+
+const _: () = assert!(std::mem::size_of::<Node>() == 256);
 
 impl Node {
     const EMPTY: Node = Node {
@@ -65,7 +67,6 @@ impl Node {
         ],
         child: [0; WIDTH],
         count: [0; WIDTH],
-        leaves: 0,
     };
 
     /// Makes `lane` the child with box `aabb`: node `child`, or a leaf of
@@ -77,9 +78,19 @@ impl Node {
         }
         self.child[lane] = child;
         if let Some(count) = leaf {
+            debug_assert!(count > 0);
             self.count[lane] = count;
-            self.leaves |= 1 << lane;
         }
+    }
+
+    /// Bit `lane` is set where the child is a leaf.
+    #[inline(always)]
+    fn leaves(&self) -> u32 {
+        let mut mask = 0;
+        for (lane, &count) in self.count.iter().enumerate() {
+            mask |= u32::from(count != 0) << lane;
+        }
+        mask
     }
 
     /// The item range of leaf `lane`.
@@ -391,7 +402,8 @@ impl WideBvh {
             let node = &self.nodes[current];
             let (mask, t_near) = ray.test::<I>(node, tmax);
             // Leaves nearest first, until the next one starts beyond the hit.
-            let mut leaves = mask & node.leaves;
+            let leaf_lanes = node.leaves();
+            let mut leaves = mask & leaf_lanes;
             while leaves != 0 {
                 let mut lane = leaves.trailing_zeros() as usize;
                 let mut rest = leaves & (leaves - 1);
@@ -408,7 +420,7 @@ impl WideBvh {
                 leaves &= !(1 << lane);
                 tmax = leaf.closest(node.items(lane), tmax);
             }
-            stack.push_lanes(node, mask & !node.leaves, &t_near, true);
+            stack.push_lanes(node, mask & !leaf_lanes, &t_near, true);
             // Next: the nearest pending node that is not beyond the hit.
             loop {
                 let Some(e) = stack.pop() else { return };
@@ -432,7 +444,8 @@ impl WideBvh {
         loop {
             let node = &self.nodes[current];
             let (mask, t_near) = ray.test::<I>(node, tmax);
-            let mut leaves = mask & node.leaves;
+            let leaf_lanes = node.leaves();
+            let mut leaves = mask & leaf_lanes;
             while leaves != 0 {
                 let lane = leaves.trailing_zeros() as usize;
                 leaves &= leaves - 1;
@@ -440,7 +453,7 @@ impl WideBvh {
                     return true;
                 }
             }
-            stack.push_lanes(node, mask & !node.leaves, &t_near, false);
+            stack.push_lanes(node, mask & !leaf_lanes, &t_near, false);
             match stack.pop() {
                 Some(e) => current = e.node as usize,
                 None => return false,
