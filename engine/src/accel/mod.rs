@@ -137,7 +137,9 @@ pub struct Accel {
     bvh: WideBvh,
     packets: Vec<Packet>,
     prims: Vec<Primitive>,
-    /// Whether queries run the AVX2 traversal (the CPU has AVX2).
+    /// Whether queries run the AVX2 traversal (the CPU has AVX2; only
+    /// read on x86_64).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     avx2: bool,
     /// Time the build took.
     pub build_time: Duration,
