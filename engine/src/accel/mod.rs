@@ -1,6 +1,6 @@
 //! Acceleration: the BVH over all primitives and robust ray queries.
 //!
-//! obvhs builds a binary BVH over the primitives' boxes, which [`wide`]
+//! obvhs builds a binary BVH over the primitives' boxes, which `wide`
 //! collapses into the 8-wide BVH that rays traverse. Primitives (triangles
 //! and analytic spheres) are numbered in its leaf order, so a leaf's
 //! primitives are contiguous and a hit's primitive index addresses the

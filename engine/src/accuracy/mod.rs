@@ -2,7 +2,7 @@
 //! error each setting leaves after a given time, and how much time a given
 //! error costs — measured, not guessed.
 //!
-//! Data flow: [`reference`] reads or renders the reference image →
+//! Data flow: [`reference`](mod@reference) reads or renders the reference image →
 //! [`sweep`] lists the settings (the scene as written with one thing
 //! changed) and renders each progressively in two seed halves
 //! ([`twin`]), measuring after every pass with [`metrics`] → [`report`]
@@ -188,7 +188,7 @@ pub fn run(
     })
 }
 
-/// The files [`write`] makes in its folder.
+/// The files [`write()`] makes in its folder.
 pub const CSV_FILE: &str = "accuracy.csv";
 /// See [`CSV_FILE`].
 pub const PLOT_FILE: &str = "accuracy.png";

@@ -106,7 +106,7 @@ pub fn reflect(v: Vec3, m: Vec3) -> Vec3 {
 }
 
 /// Refraction of `v` about the normal `m` given the cosine of the
-/// transmitted direction (from [`crate::fresnel::dielectric`]) and the
+/// transmitted direction (from the crate's `fresnel::dielectric`) and the
 /// relative index `eta_ti` (η of the side of `v` over the other side).
 #[inline]
 pub fn refract(v: Vec3, m: Vec3, cos_t: f32, eta_ti: f32) -> Vec3 {
