@@ -131,3 +131,45 @@ pub fn render_samples(
         rays,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::extract::{Overrides, extract};
+    use std::path::Path;
+
+    /// Renders the Cornell box at `width`² pixels and `spp` on a pool of
+    /// `threads` threads.
+    fn cornell(width: u32, spp: u32, threads: usize) -> Image {
+        // `expect` in this test code is the assertion: the committed scene
+        // loads and extracts, and a thread pool can be built.
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/cornell-box.yaml");
+        let scene = crate::scene::load(&path).expect("scene loads");
+        let overrides = Overrides {
+            spp: Some(spp),
+            width: Some(width),
+            height: Some(width),
+            ..Overrides::default()
+        };
+        let r = extract(&scene, &crate::builtin_registry(), &overrides).expect("scene extracts");
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("thread pool")
+            .install(|| render(&r, &Progress::none()).image)
+    }
+
+    #[test]
+    fn images_do_not_depend_on_the_thread_count() {
+        // 48² pixels are 9 tiles of 8 samples: threads take them in any
+        // order, the film adds them up in tile order.
+        let one = cornell(48, 8, 1);
+        for threads in [2, 5] {
+            assert!(
+                one.pixels == cornell(48, 8, threads).pixels,
+                "{threads} threads"
+            );
+        }
+        assert!(one.mean() > 0.0);
+    }
+}
