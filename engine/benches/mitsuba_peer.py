@@ -5,7 +5,10 @@ Times Mitsuba 3 rendering its built-in ``mi.cornell_box()`` (256x256, 64 spp,
 path integrator, max_depth 8) with the ``llvm_ad_rgb`` variant (best of 3 after
 a JIT warm-up render) and ``scalar_rgb`` (one render), then runs
 ``radiant render SCENE --spp 64`` three times and takes the best Msamples/s it
-reports on its last stderr line. Prints a table and the speed ratios.
+reports on its last stderr line. Prints the CPU (Mitsuba's JIT compiles for
+the host's widest vector unit: 16 lanes with AVX-512, 8 with AVX2, so the
+peer's speed depends on it), a table and the speed ratios. ``--threads N``
+runs both renderers on N threads (default: all).
 
     pip install mitsuba numpy && apt-get install -y libllvm19
     python3 engine/benches/mitsuba_peer.py --radiant target/release/radiant
@@ -40,6 +43,24 @@ def find_libllvm():
     return None
 
 
+def cpu_summary():
+    """The CPU's model, its logical cores and its widest vector unit."""
+    model, flags = "unknown CPU", set()
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                key, _, value = line.partition(":")
+                if key.strip() == "model name" and model == "unknown CPU":
+                    model = value.strip()
+                elif key.strip() == "flags" and not flags:
+                    flags = set(value.split())
+    except OSError:
+        pass
+    vector = ("AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags
+              else "SSE/other")
+    return f"{model}, {os.cpu_count()} logical cores, {vector}"
+
+
 def time_mitsuba(mi, variant, runs, warmup):
     """Best wall time (s) of `runs` renders of the Cornell box, or None."""
     try:
@@ -67,16 +88,17 @@ def time_mitsuba(mi, variant, runs, warmup):
     return best
 
 
-def time_radiant(binary, scene, runs):
+def time_radiant(binary, scene, runs, threads):
     """Best Msamples/s reported by `radiant render`, or None."""
     if not os.path.exists(binary):
         print(f"radiant binary {binary} not found; skipping", file=sys.stderr)
         return None
     best = None
     for i in range(runs):
-        p = subprocess.run([binary, "render", scene, "--spp", str(SPP),
-                            "-o", "/tmp/radiant_peer.exr"],
-                           capture_output=True, text=True)
+        cmd = [binary, "render", scene, "--spp", str(SPP), "-o", "/tmp/radiant_peer.exr"]
+        if threads:
+            cmd += ["--threads", str(threads)]
+        p = subprocess.run(cmd, capture_output=True, text=True)
         lines = p.stderr.strip().splitlines()
         m = RADIANT_RE.search(lines[-1]) if lines else None
         if p.returncode != 0 or not m:
@@ -94,6 +116,8 @@ def main():
                     help="path to the radiant binary")
     ap.add_argument("--scene", default="scenes/cornell-box.yaml")
     ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--threads", type=int, default=0,
+                    help="threads for both renderers (default: all cores)")
     args = ap.parse_args()
 
     if "DRJIT_LIBLLVM_PATH" not in os.environ and find_libllvm():
@@ -104,6 +128,9 @@ def main():
         print("mitsuba is not installed: run `pip install mitsuba numpy` "
               "(and `apt-get install libllvm19` for the llvm variant).")
         return 0
+    if args.threads:
+        import drjit as dr
+        dr.set_thread_count(args.threads)
 
     def msps(t):
         return SAMPLES / t / 1e6 if t else None
@@ -111,10 +138,12 @@ def main():
     results = {
         "mitsuba llvm_ad_rgb": msps(time_mitsuba(mi, "llvm_ad_rgb", args.runs, 1)),
         "mitsuba scalar_rgb": msps(time_mitsuba(mi, "scalar_rgb", 1, 0)),
-        "radiant": time_radiant(args.radiant, args.scene, args.runs),
+        "radiant": time_radiant(args.radiant, args.scene, args.runs, args.threads),
     }
 
-    print(f"\nCornell box {W}x{H}, {SPP} spp, max_depth {MAX_DEPTH}")
+    threads = args.threads or "all"
+    print(f"\nCornell box {W}x{H}, {SPP} spp, max_depth {MAX_DEPTH}, {threads} threads")
+    print(f"CPU: {cpu_summary()}")
     print(f"{'renderer':<22}{'Msamples/s':>12}")
     for name, v in results.items():
         print(f"{name:<22}{(f'{v:.3f}' if v else 'n/a'):>12}")

@@ -455,8 +455,10 @@ impl LeafVisitor for Query<'_> {
 /// positive `tmax` (not NaN). Other rays hit nothing.
 #[inline(always)]
 fn ray_is_valid(origin: Vec3, dir: Vec3, tmax: f32) -> bool {
-    let finite = |v: Vec3| Vec3A::from(v).is_finite();
-    finite(origin) && finite(dir) && tmax > 0.0
+    // x·0 is 0 for finite x and NaN for ±∞ and NaN: one comparison checks
+    // all six coordinates.
+    let zeros = Vec3A::from(origin) * 0.0 + Vec3A::from(dir) * 0.0;
+    zeros.cmpeq(Vec3A::ZERO).all() && tmax > 0.0
 }
 
 /// [`sphere::intersect`], kept out of the triangle loops so that they

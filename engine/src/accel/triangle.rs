@@ -10,45 +10,42 @@
 //! watertightness carries over. The ray's axis permutation only selects
 //! which coordinate arrays are loaded, so it costs nothing.
 
-use glam::{BVec3A, BVec4A, DVec3, Vec3, Vec3A, Vec3Swizzles, Vec4};
+use glam::{BVec4A, DVec3, Vec3, Vec4};
 
 /// Per-ray constants of the watertight test.
 #[derive(Debug, Clone, Copy)]
 pub struct RayPrep {
-    /// The origin's coordinates along the permuted axes, in every lane.
-    origin: [Vec4; 3],
-    /// The shear constants (sx, sy, sz), in every lane.
-    shear: [Vec4; 3],
+    /// The origin's coordinates along the permuted axes.
+    origin: [f32; 3],
+    /// The shear constants (sx, sy, sz).
+    shear: [f32; 3],
     /// The axes that become x, y and z: z is the direction's dominant axis,
     /// x and y follow cyclically, which keeps the triangles' winding.
     axes: [usize; 3],
 }
 
+/// [`RayPrep::axes`] by dominant axis.
+const AXES: [[usize; 3]; 3] = [[1, 2, 0], [2, 0, 1], [0, 1, 2]];
+
 impl RayPrep {
     /// Prepares the ray `origin + t·dir`.
     #[inline(always)]
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        let (o, d) = (Vec3A::from(origin), Vec3A::from(dir));
-        let a = d.abs();
+        let a = dir.abs();
         // The dominant axis (the last of equal ones but the first), chosen
         // without branches: random directions would mispredict them.
         let x_gt_y = a.x > a.y;
         let is_x = x_gt_y & (a.x > a.z);
         let is_y = !x_gt_y & (a.y > a.z);
-        let kz = 2 - 2 * usize::from(is_x) - usize::from(is_y);
-        // Rotate the axes so that kz comes last: xyz, yzx or zxy.
-        let rotate = |v: Vec3A| {
-            let v = Vec3A::select(BVec3A::splat(is_y), v.zxy(), v);
-            Vec3A::select(BVec3A::splat(is_x), v.yzx(), v)
-        };
-        let (o, d) = (rotate(o), rotate(d));
-        // One vector division: the same correctly rounded quotients as
-        // three scalar ones.
-        let shear = Vec3A::new(-d.x, -d.y, 1.0) / d.z;
+        let axes = AXES[2 - 2 * usize::from(is_x) - usize::from(is_y)];
+        // Rotate the axes so that kz comes last: xyz, yzx or zxy (the
+        // entries are below 3; `min` lets the compiler see it).
+        let [kx, ky, kz] = axes.map(|k| k.min(2));
+        let (o, d) = (origin.to_array(), dir.to_array());
         Self {
-            origin: [o.x, o.y, o.z].map(Vec4::splat),
-            shear: [shear.x, shear.y, shear.z].map(Vec4::splat),
-            axes: [(kz + 1) % 3, (kz + 2) % 3, kz],
+            origin: [o[kx], o[ky], o[kz]],
+            shear: [-d[kx] / d[kz], -d[ky] / d[kz], 1.0 / d[kz]],
+            axes,
         }
     }
 }
@@ -154,8 +151,8 @@ impl Tri4 {
     fn test(&self, ray: &RayPrep, tmax: f32) -> Lanes {
         // In range by construction; `min` lets the compiler see it.
         let [kx, ky, kz] = ray.axes.map(|k| k.min(2));
-        let [ox, oy, oz] = ray.origin;
-        let [sx, sy, sz] = ray.shear;
+        let [ox, oy, oz] = ray.origin.map(Vec4::splat);
+        let [sx, sy, sz] = ray.shear.map(Vec4::splat);
         // Translate to the ray origin, permute so the ray runs along +z,
         // and shear x and y (pbrt-v4 §6.5.3); z is scaled further below.
         let transform = |p: &[Vec4; 3]| {
@@ -249,20 +246,12 @@ impl Tri4 {
                 DVec3::new(p[kx][lane].into(), p[ky][lane].into(), p[kz][lane].into())
             };
             let (v0, v1, v2) = (vertex(0), vertex(1), vertex(2));
-            let origin = DVec3::new(
-                ray.origin[0][0].into(),
-                ray.origin[1][0].into(),
-                ray.origin[2][0].into(),
-            );
+            let origin = DVec3::from(ray.origin.map(f64::from));
             // The ray in the permuted axes is origin + t'·(−sx, −sy, 1),
             // with t = t'·sz.
-            let dir = DVec3::new(
-                -f64::from(ray.shear[0][0]),
-                -f64::from(ray.shear[1][0]),
-                1.0,
-            );
+            let dir = DVec3::new(-f64::from(ray.shear[0]), -f64::from(ray.shear[1]), 1.0);
             let n = (v1 - v0).cross(v2 - v0);
-            let t = (v0 - origin).dot(n) / dir.dot(n) * f64::from(ray.shear[2][0]);
+            let t = (v0 - origin).dot(n) / dir.dot(n) * f64::from(ray.shear[2]);
             keep[lane] = t > 0.0;
         }
         BVec4A::new(keep[0], keep[1], keep[2], keep[3])

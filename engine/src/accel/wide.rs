@@ -214,8 +214,8 @@ impl Avx2 {
 /// Per-ray constants of the box test.
 #[derive(Debug, Clone, Copy)]
 pub struct RayBoxes {
-    origin: [Vec4; 3],
-    inv_dir: [Vec4; 3],
+    origin: [f32; 3],
+    inv_dir: [f32; 3],
     /// Per axis: which of `Node::bounds` the ray meets first (0: minimum).
     near: [usize; 3],
 }
@@ -230,8 +230,8 @@ impl RayBoxes {
         let inv_dir = Vec3A::ONE / Vec3A::from(dir);
         let negative = inv_dir.cmplt(Vec3A::ZERO).bitmask() as usize;
         Self {
-            origin: [origin.x, origin.y, origin.z].map(Vec4::splat),
-            inv_dir: [inv_dir.x, inv_dir.y, inv_dir.z].map(Vec4::splat),
+            origin: origin.to_array(),
+            inv_dir: inv_dir.to_array(),
             near: [negative & 1, (negative >> 1) & 1, negative >> 2],
         }
     }
@@ -259,8 +259,8 @@ impl RayBoxes {
         let mut t_far = _mm256_set1_ps(tmax);
         for axis in 0..3 {
             let near = self.near[axis] & 1;
-            let origin = _mm256_set1_ps(self.origin[axis].x);
-            let inv_dir = _mm256_set1_ps(self.inv_dir[axis].x);
+            let origin = _mm256_set1_ps(self.origin[axis]);
+            let inv_dir = _mm256_set1_ps(self.inv_dir[axis]);
             let bounds = |side: usize| {
                 // SAFETY: a group pair is eight contiguous f32 in a 64-byte
                 // aligned node, at a multiple of 32 bytes (an aligned load).
@@ -291,8 +291,12 @@ impl RayBoxes {
             let mut t_far = Vec4::splat(tmax);
             for axis in 0..3 {
                 let near = self.near[axis] & 1;
-                let lo = (node.bounds[near][axis][g] - self.origin[axis]) * self.inv_dir[axis];
-                let hi = (node.bounds[near ^ 1][axis][g] - self.origin[axis]) * self.inv_dir[axis];
+                let (origin, inv_dir) = (
+                    Vec4::splat(self.origin[axis]),
+                    Vec4::splat(self.inv_dir[axis]),
+                );
+                let lo = (node.bounds[near][axis][g] - origin) * inv_dir;
+                let hi = (node.bounds[near ^ 1][axis][g] - origin) * inv_dir;
                 t_near = max_of(lo, t_near);
                 t_far = min_of(hi, t_far);
             }

@@ -70,8 +70,10 @@ impl FilterTable {
     /// The table cell of offset `d` along one axis, if inside the support.
     #[inline]
     fn index(&self, d: f32) -> Option<usize> {
-        let i = (d.abs() * self.scale) as usize;
-        (i < TABLE_RES).then_some(i)
+        let x = d.abs() * self.scale;
+        // In [0, TABLE_RES) (so not NaN) before the conversion, which then
+        // is a plain truncation.
+        (x < TABLE_RES as f32).then_some(x as i32 as usize)
     }
 
     /// The separable factor g at offset `d` (see `separable`).
@@ -196,10 +198,10 @@ impl TileFilm {
     pub fn splat(&mut self, pos: Vec2, value: Rgb, table: &FilterTable) {
         let value = self.checked(value);
         let r = table.radius;
-        let px0 = ((pos.x - 0.5 - r).ceil() as i32).max(0);
-        let px1 = ((pos.x - 0.5 + r).floor() as i32).min(self.image_width - 1);
-        let py0 = ((pos.y - 0.5 - r).ceil() as i32).max(0);
-        let py1 = ((pos.y - 0.5 + r).floor() as i32).min(self.image_height - 1);
+        let px0 = ceil_i32(pos.x - 0.5 - r).max(0);
+        let px1 = floor_i32(pos.x - 0.5 + r).min(self.image_width - 1);
+        let py0 = ceil_i32(pos.y - 0.5 - r).max(0);
+        let py1 = floor_i32(pos.y - 0.5 + r).min(self.image_height - 1);
         let v = value.extend(1.0);
         let taps = (px1 - px0 + 1).max(0) as usize;
         if let (Some(g), true) = (&table.separable, taps <= MAX_TAPS) {
@@ -251,6 +253,21 @@ impl TileFilm {
         let i = ((y as i32 - self.y0) * self.width + x as i32 - self.x0) as usize;
         self.sums[i] += (value * weight).extend(weight);
     }
+}
+
+/// `x.ceil() as i32` without the libm call that the baseline x86-64
+/// instruction set needs for `ceil` (it has no rounding instruction).
+#[inline(always)]
+fn ceil_i32(x: f32) -> i32 {
+    let i = x as i32;
+    i.saturating_add(i32::from((i as f32) < x))
+}
+
+/// `x.floor() as i32`; see [`ceil_i32`].
+#[inline(always)]
+fn floor_i32(x: f32) -> i32 {
+    let i = x as i32;
+    i.saturating_sub(i32::from((i as f32) > x))
 }
 
 /// The whole image's weighted sums.
@@ -317,6 +334,38 @@ mod tests {
         }
         fn eval(&self, x: f32, y: f32) -> f32 {
             (1.5 - x.abs()).max(0.0) * (1.5 - y.abs()).max(0.0)
+        }
+    }
+
+    #[test]
+    fn integer_rounding_matches_std() {
+        let mut values = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            2.5,
+            -2.5,
+            1e-30,
+            -1e-30,
+            8_388_607.5,
+            -8_388_607.5,
+            2.1e9,
+            -2.1e9,
+            3e9,
+            -3e9,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        values.extend((0..2000).map(|i| (i as f32 - 1000.0) * 0.37));
+        for x in values {
+            assert_eq!(ceil_i32(x), x.ceil() as i32, "ceil {x}");
+            assert_eq!(floor_i32(x), x.floor() as i32, "floor {x}");
         }
     }
 

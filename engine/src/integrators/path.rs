@@ -223,8 +223,16 @@ impl Wavefront {
                 *w = weight;
             }
         }
-        for (f, id) in self.film.iter_mut().zip(&self.ids) {
-            *f += Vec2::new((id.pixel % width) as f32, (id.pixel / width) as f32);
+        // Raster positions: the pixels' corners plus the offsets. The
+        // loops of the ids above, so no division per sample.
+        let mut film = self.film.iter_mut();
+        for y in b.y0..b.y1 {
+            for x in b.x0..b.x1 {
+                let corner = Vec2::new(x as f32, y as f32);
+                for f in film.by_ref().take(b.samples as usize) {
+                    *f += corner;
+                }
+            }
         }
         fit(&mut self.origin, n);
         fit(&mut self.dir, n);
