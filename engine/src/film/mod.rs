@@ -71,15 +71,22 @@ impl FilterTable {
     #[inline]
     fn index(&self, d: f32) -> Option<usize> {
         let x = d.abs() * self.scale;
-        // In [0, TABLE_RES) (so not NaN) before the conversion, which then
-        // is a plain truncation.
-        (x < TABLE_RES as f32).then_some(x as i32 as usize)
+        // SAFETY: 0 ≤ x < TABLE_RES (so not NaN) where it is converted, so
+        // the truncation is in range (and needs none of the checks of a
+        // saturating `as`).
+        (x < TABLE_RES as f32).then(|| unsafe { x.to_int_unchecked::<u32>() } as usize)
     }
 
-    /// The separable factor g at offset `d` (see `separable`).
-    #[inline]
-    fn factor(factor: &[f32], index: Option<usize>) -> f32 {
-        index.map_or(0.0, |i| factor[i])
+    /// The separable factors g(c + ½ − `centre`) of the pixels c =
+    /// `first`, `first + 1`, … along one axis, as many as `out` holds (0
+    /// outside the support); `factor` is `separable`.
+    #[inline(always)]
+    fn factors(&self, factor: &[f32], first: i32, centre: f32, out: &mut [f32]) {
+        for (c, w) in (first..).zip(out) {
+            *w = self
+                .index(c as f32 + 0.5 - centre)
+                .map_or(0.0, |i| factor[i]);
+        }
     }
 }
 
@@ -204,20 +211,19 @@ impl TileFilm {
         let py1 = floor_i32(pos.y - 0.5 + r).min(self.image_height - 1);
         let v = value.extend(1.0);
         let taps = (px1 - px0 + 1).max(0) as usize;
-        if let (Some(g), true) = (&table.separable, taps <= MAX_TAPS) {
-            // One column of weights, reused on every row.
-            let mut wx = [0.0f32; MAX_TAPS];
-            for (j, w) in wx[..taps].iter_mut().enumerate() {
-                let dx = (px0 + j as i32) as f32 + 0.5 - pos.x;
-                *w = FilterTable::factor(g, table.index(dx));
-            }
-            for y in py0..=py1 {
-                let wy = FilterTable::factor(g, table.index(y as f32 + 0.5 - pos.y));
-                let start = ((y - self.y0) * self.width + px0 - self.x0) as usize;
-                let vy = v * wy;
+        let rows = (py1 - py0 + 1).max(0) as usize;
+        if let (Some(g), true) = (&table.separable, taps.max(rows) <= MAX_TAPS) {
+            // A row and a column of weights; each pixel takes their product.
+            let (mut wx, mut wy) = ([0.0f32; MAX_TAPS], [0.0f32; MAX_TAPS]);
+            table.factors(g, px0, pos.x, &mut wx[..taps]);
+            table.factors(g, py0, pos.y, &mut wy[..rows]);
+            let mut start = ((py0 - self.y0) * self.width + px0 - self.x0) as usize;
+            for &w in &wy[..rows] {
+                let vy = v * w;
                 for (sum, &w) in self.sums[start..start + taps].iter_mut().zip(&wx[..taps]) {
                     *sum += vy * w;
                 }
+                start += self.width as usize;
             }
             return;
         }
