@@ -313,24 +313,38 @@ impl Wavefront {
     /// Drops paths that escaped (keeping them in `esc_slots` if `has_env`),
     /// resolves hits, adds emission.
     fn resolve_hits(&mut self, scene: &RenderScene, depth: u32, has_area: bool, has_env: bool) {
-        self.em_slots.clear();
-        self.esc_slots.clear();
-        self.next_live.clear();
-        for &slot in &self.live {
+        let n = self.live.len();
+        fit(&mut self.next_live, n);
+        fit(&mut self.em_slots, n);
+        fit(&mut self.esc_slots, if has_env { n } else { 0 });
+        // Slices taken once (bounds in registers); slots written by count.
+        let (live, hits) = (&self.live[..], &self.hit[..]);
+        let (origin, dir, its) = (&self.origin[..], &self.dir[..], &mut self.its[..]);
+        let (next, emitting) = (&mut self.next_live[..], &mut self.em_slots[..]);
+        let escaped = &mut self.esc_slots[..];
+        let emitter = &scene.surfaces.emitter[..];
+        let (mut m, mut em, mut esc) = (0, 0, 0);
+        for &slot in live {
             let i = slot as usize;
-            let hit = self.hit[i];
+            let hit = hits[i];
             if hit.prim == Hit::MISS.prim {
                 if has_env {
-                    self.esc_slots.push(slot);
+                    escaped[esc] = slot;
+                    esc += 1;
                 }
                 continue;
             }
-            self.its[i] = interaction(scene, &hit, self.origin[i], self.dir[i]);
-            if has_area && scene.surfaces.emitter[hit.prim as usize] != NO_EMITTER {
-                self.em_slots.push(slot);
+            its[i] = interaction(scene, &hit, origin[i], dir[i]);
+            if has_area && emitter[hit.prim as usize] != NO_EMITTER {
+                emitting[em] = slot;
+                em += 1;
             }
-            self.next_live.push(slot);
+            next[m] = slot;
+            m += 1;
         }
+        self.next_live.truncate(m);
+        self.em_slots.truncate(em);
+        self.esc_slots.truncate(esc);
         std::mem::swap(&mut self.live, &mut self.next_live);
         if self.em_slots.is_empty() {
             return;
@@ -417,11 +431,13 @@ impl Wavefront {
         fit(&mut self.ids_k, n);
         fit(&mut self.wo, n);
         fit(&mut self.uv, n);
-        for (k, &slot) in self.live.iter().enumerate() {
+        let (ids, its, dir) = (&self.ids[..], &self.its[..], &self.dir[..]);
+        let outputs = self.ids_k.iter_mut().zip(&mut self.wo).zip(&mut self.uv);
+        for (((id, wo), uv), &slot) in outputs.zip(&self.live) {
             let i = slot as usize;
-            self.ids_k[k] = self.ids[i];
-            self.wo[k] = self.its[i].frame.to_local(-self.dir[i]);
-            self.uv[k] = self.its[i].uv;
+            *id = ids[i];
+            *wo = its[i].frame.to_local(-dir[i]);
+            *uv = its[i].uv;
         }
         n
     }
@@ -439,8 +455,9 @@ impl Wavefront {
             self.light.fill(0);
             self.light_prob.fill(1.0);
             fit(&mut self.refs, n);
+            let its = &self.its[..];
             for (r, &slot) in self.refs.iter_mut().zip(&self.live) {
-                *r = self.its[slot as usize].p;
+                *r = its[slot as usize].p;
             }
             light.sample(&self.refs, &self.u2, &mut self.light_sample);
         } else {
@@ -449,11 +466,13 @@ impl Wavefront {
         // Directions towards the light samples, in the local frames.
         fit(&mut self.nee_wi, n);
         fit(&mut self.nee_wi_world, n);
-        for k in 0..n {
-            let it = &self.its[self.live[k] as usize];
-            let wi = (self.light_sample[k].p - it.p).normalize_or_zero();
-            self.nee_wi_world[k] = wi;
-            self.nee_wi[k] = it.frame.to_local(wi);
+        let its = &self.its[..];
+        let outputs = self.nee_wi_world.iter_mut().zip(&mut self.nee_wi);
+        for ((world, local), (&slot, ls)) in outputs.zip(self.live.iter().zip(&self.light_sample)) {
+            let it = &its[slot as usize];
+            let wi = (ls.p - it.p).normalize_or_zero();
+            *world = wi;
+            *local = it.frame.to_local(wi);
         }
     }
 
@@ -543,33 +562,46 @@ impl Wavefront {
 
     /// Weights the light samples and traces their shadow rays.
     fn next_event(&mut self, scene: &RenderScene, n: usize) {
-        self.shadow_slot.clear();
-        self.shadow_origin.clear();
-        self.shadow_dir.clear();
-        self.shadow_value.clear();
+        fit(&mut self.shadow_slot, n);
+        fit(&mut self.shadow_origin, n);
+        fit(&mut self.shadow_dir, n);
+        fit(&mut self.shadow_value, n);
+        // Slices taken once, so that the loop keeps their bounds in
+        // registers, and shadow rays written by count rather than pushed.
+        let (light_sample, nee_eval, live) = (
+            &self.light_sample[..n],
+            &self.nee_eval[..n],
+            &self.live[..n],
+        );
+        let (wi_world, wi_local) = (&self.nee_wi_world[..n], &self.nee_wi[..n]);
+        let (light, light_prob) = (&self.light[..n], &self.light_prob[..n]);
+        let (its, beta) = (&self.its[..], &self.beta[..]);
+        let (slots, origins) = (&mut self.shadow_slot[..], &mut self.shadow_origin[..]);
+        let (dirs, values) = (&mut self.shadow_dir[..], &mut self.shadow_value[..]);
+        let mut m = 0;
         for k in 0..n {
-            let ls = self.light_sample[k];
-            let e = self.nee_eval[k];
+            let ls = light_sample[k];
+            let e = nee_eval[k];
             if ls.pdf <= 0.0 || e.value == Rgb::ZERO {
                 continue;
             }
-            let slot = self.live[k];
+            let slot = live[k];
             let i = slot as usize;
-            let it = &self.its[i];
-            let wi = self.nee_wi_world[k];
+            let it = &its[i];
+            let wi = wi_world[k];
             // Shading and geometric normals must agree on the side.
-            if wi.dot(it.ng) * self.nee_wi[k].z <= 0.0 {
+            if wi.dot(it.ng) * wi_local[k].z <= 0.0 {
                 continue;
             }
-            let light_pdf = self.light_prob[k] * ls.pdf;
+            let light_pdf = light_prob[k] * ls.pdf;
             // The MIS weight over the density, w / light_pdf, in one
             // division: 1/p for delta lights, p/(p² + bsdf²) otherwise.
-            let weight = if scene.lights.is_delta(self.light[k] as usize) {
+            let weight = if scene.lights.is_delta(light[k] as usize) {
                 1.0 / light_pdf
             } else {
                 light_pdf / (light_pdf * light_pdf + e.pdf * e.pdf)
             };
-            let value = self.beta[i] * e.value * ls.radiance * weight;
+            let value = beta[i] * e.value * ls.radiance * weight;
             if value == Rgb::ZERO || !value.is_finite() {
                 continue;
             }
@@ -579,11 +611,16 @@ impl Wavefront {
             } else {
                 offset_origin(ls.p, sampled_point_error(ls.p), ls.n, -wi)
             };
-            self.shadow_slot.push(slot);
-            self.shadow_origin.push(origin);
-            self.shadow_dir.push(target - origin);
-            self.shadow_value.push(value);
+            slots[m] = slot;
+            origins[m] = origin;
+            dirs[m] = target - origin;
+            values[m] = value;
+            m += 1;
         }
+        self.shadow_slot.truncate(m);
+        self.shadow_origin.truncate(m);
+        self.shadow_dir.truncate(m);
+        self.shadow_value.truncate(m);
         fit(&mut self.shadow_blocked, self.shadow_slot.len());
         scene.accel.occluded_each(
             &self.shadow_origin,
@@ -591,9 +628,11 @@ impl Wavefront {
             1.0 - SHADOW_EPSILON,
             &mut self.shadow_blocked,
         );
-        for (j, &slot) in self.shadow_slot.iter().enumerate() {
-            if !self.shadow_blocked[j] {
-                self.radiance[slot as usize] += self.shadow_value[j];
+        let radiance = &mut self.radiance[..];
+        let rays = self.shadow_slot.iter().zip(&self.shadow_blocked);
+        for ((&slot, &blocked), &value) in rays.zip(&self.shadow_value) {
+            if !blocked {
+                radiance[slot as usize] += value;
             }
         }
         self.rays += self.shadow_slot.len() as u64;
@@ -605,20 +644,32 @@ impl Wavefront {
         fit(&mut self.u1, n);
         scene.sampler.fill_1d(&self.ids_k, base + 6, &mut self.u1);
         let rr = depth + 1 >= scene.settings.rr_depth;
-        self.next_live.clear();
+        fit(&mut self.next_live, n);
+        // Slices taken once (bounds in registers); survivors written by
+        // count.
+        let (bsdf, live, u) = (&self.bsdf[..n], &self.live[..n], &self.u1[..n]);
+        let its = &self.its[..];
+        let (beta_of, eta_of) = (&mut self.beta[..], &mut self.eta_scale[..]);
+        let (prev_pdf, origin, dir) = (
+            &mut self.prev_pdf[..],
+            &mut self.origin[..],
+            &mut self.dir[..],
+        );
+        let next = &mut self.next_live[..];
+        let mut m = 0;
         for k in 0..n {
-            let s = self.bsdf[k];
+            let s = bsdf[k];
             if s.pdf <= 0.0 || s.weight == Rgb::ZERO {
                 continue;
             }
-            let slot = self.live[k];
+            let slot = live[k];
             let i = slot as usize;
-            let it = &self.its[i];
+            let it = &its[i];
             let wi = it.frame.to_world(s.wi);
             if wi.dot(it.ng) * s.wi.z <= 0.0 {
                 continue;
             }
-            let mut beta = self.beta[i] * s.weight;
+            let mut beta = beta_of[i] * s.weight;
             let beta_max = beta.max_element();
             if beta_max <= 0.0 || !beta.is_finite() {
                 continue;
@@ -627,21 +678,23 @@ impl Wavefront {
             // refraction (pbrt-v4, Cycles, Mitsuba's η² tracking): a path
             // whose throughput is still 1 (mirrors, glass) is never killed
             // at random, so it gathers no 1/q^k weight.
-            let eta_scale = self.eta_scale[i] * s.eta * s.eta;
+            let eta_scale = eta_of[i] * s.eta * s.eta;
             let survival = beta_max * eta_scale;
             if rr && survival < 1.0 {
-                if self.u1[k] >= survival {
+                if u[k] >= survival {
                     continue;
                 }
                 beta /= survival;
             }
-            self.beta[i] = beta;
-            self.eta_scale[i] = eta_scale;
-            self.prev_pdf[i] = if s.delta { 0.0 } else { s.pdf };
-            self.origin[i] = offset_origin(it.p, it.err, it.ng, wi);
-            self.dir[i] = wi;
-            self.next_live.push(slot);
+            beta_of[i] = beta;
+            eta_of[i] = eta_scale;
+            prev_pdf[i] = if s.delta { 0.0 } else { s.pdf };
+            origin[i] = offset_origin(it.p, it.err, it.ng, wi);
+            dir[i] = wi;
+            next[m] = slot;
+            m += 1;
         }
+        self.next_live.truncate(m);
         std::mem::swap(&mut self.live, &mut self.next_live);
     }
 }
