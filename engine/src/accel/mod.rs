@@ -223,7 +223,8 @@ impl Accel {
             // SAFETY: `avx2` is set only where the CPU supports AVX2.
             return unsafe { self.intersect_avx2(origin, dir, tmax) };
         }
-        self.intersect_with::<Baseline>(origin, dir, tmax)
+        let hit = self.intersect_with::<Baseline>(origin, dir, tmax);
+        (hit.prim != Hit::MISS.prim).then_some(hit)
     }
 
     /// Whether anything blocks `origin + t·dir` for `t` in (0, `tmax`).
@@ -281,7 +282,8 @@ impl Accel {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn intersect_avx2(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Option<Hit> {
-        self.intersect_with::<Avx2>(origin, dir, tmax)
+        let hit = self.intersect_with::<Avx2>(origin, dir, tmax);
+        (hit.prim != Hit::MISS.prim).then_some(hit)
     }
 
     /// [`Self::occluded`] compiled for AVX2.
@@ -322,9 +324,7 @@ impl Accel {
     ) {
         for &slot in slots {
             let i = slot as usize;
-            hits[i] = self
-                .intersect_with::<I>(origins[i], dirs[i], f32::INFINITY)
-                .unwrap_or(Hit::MISS);
+            hits[i] = self.intersect_with::<I>(origins[i], dirs[i], f32::INFINITY);
         }
     }
 
@@ -349,11 +349,12 @@ impl Accel {
         self.avx2 = false;
     }
 
-    /// [`Self::intersect`] with the instruction set `I`.
+    /// [`Self::intersect`] with the instruction set `I`; [`Hit::MISS`]
+    /// where nothing is hit.
     #[inline(always)]
-    fn intersect_with<I: Isa>(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Option<Hit> {
+    fn intersect_with<I: Isa>(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Hit {
         if self.bvh.is_empty() || !ray_is_valid(origin, dir, tmax) {
-            return None;
+            return Hit::MISS;
         }
         let prep = RayPrep::new(origin, dir);
         let mut query = Query::new(&self.packets, origin, dir, &prep);
@@ -382,7 +383,8 @@ struct Query<'a> {
     origin: Vec3,
     dir: Vec3,
     prep: &'a RayPrep,
-    best: Option<Hit>,
+    /// [`Hit::MISS`] until something is hit.
+    best: Hit,
 }
 
 impl<'a> Query<'a> {
@@ -393,7 +395,7 @@ impl<'a> Query<'a> {
             origin,
             dir,
             prep,
-            best: None,
+            best: Hit::MISS,
         }
     }
 }
@@ -406,12 +408,12 @@ impl LeafVisitor for Query<'_> {
                 Packet::Triangles { ref tris, first } => {
                     if let Some(h) = tris.closest(self.prep, tmax) {
                         tmax = h.t;
-                        self.best = Some(Hit {
+                        self.best = Hit {
                             t: h.t,
                             prim: first + h.lane as u32,
                             b1: h.b1,
                             b2: h.b2,
-                        });
+                        };
                     }
                 }
                 Packet::Sphere {
@@ -421,12 +423,12 @@ impl LeafVisitor for Query<'_> {
                 } => {
                     if let Some(t) = hit_sphere(self.origin, self.dir, centre, radius, tmax) {
                         tmax = t;
-                        self.best = Some(Hit {
+                        self.best = Hit {
                             t,
                             prim,
                             b1: 0.0,
                             b2: 0.0,
-                        });
+                        };
                     }
                 }
             }
