@@ -223,8 +223,8 @@ impl Wavefront {
                 *w = weight;
             }
         }
-        // Raster positions: the pixels' corners plus the offsets. The
-        // loops of the ids above, so no division per sample.
+        // Raster positions: each pixel's corner plus its samples' offsets,
+        // in the order the ids were made above (no division per sample).
         let mut film = self.film.iter_mut();
         for y in b.y0..b.y1 {
             for x in b.x0..b.x1 {
