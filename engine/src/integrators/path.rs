@@ -169,8 +169,8 @@ impl Wavefront {
         }
         match reconstruction {
             Reconstruction::Splat(table) => {
-                for i in 0..n {
-                    tile.splat(self.film[i], self.radiance[i], table);
+                for (&pos, &value) in self.film[..n].iter().zip(&self.radiance[..n]) {
+                    tile.splat(pos, value, table);
                 }
             }
             Reconstruction::Importance(_) => {
@@ -197,15 +197,15 @@ impl Wavefront {
     ) {
         let width = scene.settings.width;
         fit(&mut self.ids, n);
-        let mut i = 0;
+        let mut ids = self.ids.iter_mut();
         for y in b.y0..b.y1 {
             for x in b.x0..b.x1 {
-                for s in b.first_sample..b.first_sample + b.samples {
-                    self.ids[i] = SampleId {
+                let samples = b.first_sample..b.first_sample + b.samples;
+                for (id, index) in ids.by_ref().take(b.samples as usize).zip(samples) {
+                    *id = SampleId {
                         pixel: y * width + x,
-                        index: s,
+                        index,
                     };
-                    i += 1;
                 }
             }
         }
@@ -530,8 +530,8 @@ impl Wavefront {
         fit(&mut self.u2, n);
         scene.sampler.fill_1d(&self.ids_k, base + 3, &mut self.u1);
         scene.sampler.fill_2d(&self.ids_k, base + 4, &mut self.u2);
-        for k in 0..n {
-            self.u3[k] = Vec3::new(self.u1[k], self.u2[k].x, self.u2[k].y);
+        for ((u3, &u1), u2) in self.u3.iter_mut().zip(&self.u1).zip(&self.u2) {
+            *u3 = Vec3::new(u1, u2.x, u2.y);
         }
         fit(&mut self.bsdf, n);
         fit(&mut self.nee_eval, n);

@@ -14,8 +14,9 @@ pub(crate) fn sort_by_key(
 ) {
     offsets.clear();
     offsets.resize(keys + 1, 0);
+    let counts = &mut offsets[..];
     for &i in items.iter() {
-        offsets[key(i) as usize + 1] += 1;
+        counts[key(i) as usize + 1] += 1;
     }
     for k in 0..keys {
         offsets[k + 1] += offsets[k];
@@ -27,9 +28,10 @@ pub(crate) fn sort_by_key(
     scratch.resize(items.len(), 0);
     cursor.clear();
     cursor.extend_from_slice(&offsets[..keys]);
+    let (sorted, cursor) = (&mut scratch[..], &mut cursor[..]);
     for &i in items.iter() {
         let k = key(i) as usize;
-        scratch[cursor[k] as usize] = i;
+        sorted[cursor[k] as usize] = i;
         cursor[k] += 1;
     }
     std::mem::swap(items, scratch);
