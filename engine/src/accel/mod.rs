@@ -219,10 +219,13 @@ impl Accel {
     #[inline]
     pub fn intersect(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Option<Hit> {
         #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
+        let hit = if self.avx2 {
             // SAFETY: `avx2` is set only where the CPU supports AVX2.
-            return unsafe { self.intersect_avx2(origin, dir, tmax) };
-        }
+            unsafe { self.intersect_avx2(origin, dir, tmax) }
+        } else {
+            self.intersect_with::<Baseline>(origin, dir, tmax)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
         let hit = self.intersect_with::<Baseline>(origin, dir, tmax);
         (hit.prim != Hit::MISS.prim).then_some(hit)
     }
@@ -281,9 +284,8 @@ impl Accel {
     /// [`Self::intersect`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn intersect_avx2(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Option<Hit> {
-        let hit = self.intersect_with::<Avx2>(origin, dir, tmax);
-        (hit.prim != Hit::MISS.prim).then_some(hit)
+    fn intersect_avx2(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Hit {
+        self.intersect_with::<Avx2>(origin, dir, tmax)
     }
 
     /// [`Self::occluded`] compiled for AVX2.

@@ -77,16 +77,11 @@ impl FilterTable {
         (x < TABLE_RES as f32).then(|| unsafe { x.to_int_unchecked::<u32>() } as usize)
     }
 
-    /// The separable factors g(c + ½ − `centre`) of the pixels c =
-    /// `first`, `first + 1`, … along one axis, as many as `out` holds (0
-    /// outside the support); `factor` is `separable`.
+    /// The separable factor g at offset `d` (0 outside the support);
+    /// `factor` is `separable`.
     #[inline(always)]
-    fn factors(&self, factor: &[f32], first: i32, centre: f32, out: &mut [f32]) {
-        for (c, w) in (first..).zip(out) {
-            *w = self
-                .index(c as f32 + 0.5 - centre)
-                .map_or(0.0, |i| factor[i]);
-        }
+    fn factor(&self, factor: &[f32], d: f32) -> f32 {
+        self.index(d).map_or(0.0, |i| factor[i])
     }
 }
 
@@ -211,15 +206,15 @@ impl TileFilm {
         let py1 = floor_i32(pos.y - 0.5 + r).min(self.image_height - 1);
         let v = value.extend(1.0);
         let taps = (px1 - px0 + 1).max(0) as usize;
-        let rows = (py1 - py0 + 1).max(0) as usize;
-        if let (Some(g), true) = (&table.separable, taps.max(rows) <= MAX_TAPS) {
-            // A row and a column of weights; each pixel takes their product.
-            let (mut wx, mut wy) = ([0.0f32; MAX_TAPS], [0.0f32; MAX_TAPS]);
-            table.factors(g, px0, pos.x, &mut wx[..taps]);
-            table.factors(g, py0, pos.y, &mut wy[..rows]);
+        if let (Some(g), true) = (&table.separable, taps <= MAX_TAPS) {
+            // One row of weights, reused on every row of pixels.
+            let mut wx = [0.0f32; MAX_TAPS];
+            for (x, w) in (px0..).zip(&mut wx[..taps]) {
+                *w = table.factor(g, x as f32 + 0.5 - pos.x);
+            }
             let mut start = ((py0 - self.y0) * self.width + px0 - self.x0) as usize;
-            for &w in &wy[..rows] {
-                let vy = v * w;
+            for y in py0..=py1 {
+                let vy = v * table.factor(g, y as f32 + 0.5 - pos.y);
                 for (sum, &w) in self.sums[start..start + taps].iter_mut().zip(&wx[..taps]) {
                     *sum += vy * w;
                 }
