@@ -1,26 +1,36 @@
 #!/usr/bin/env python3
 """Peer benchmark of the ray-tracing core: Radiant's BVH vs Embree.
 
-Builds Embree (through ``embreex``, Embree 4 with its default build) over a
-triangle mesh and times single-ray closest-hit and occlusion queries on the
-rays ``engine/examples/trace_probe.rs`` uses for meshes: 1M rays from a
-sphere around the mesh towards uniform points of its bounding box (shadow
-rays end at that point). Then runs the probe on the same mesh and prints
-nanoseconds per ray of both and Radiant's time as a ratio of Embree's.
-Both run single-threaded on the same machine, best of 5 passes.
+Builds Embree (through ``embreex``, Embree 4 with its default build) over
+triangles and times single-ray closest-hit and occlusion queries on the rays
+``engine/examples/trace_probe.rs`` uses, then runs the probe and prints
+nanoseconds per ray of both and Radiant's time as a ratio of Embree's. Both
+run single-threaded on the same machine, best of 5 passes.
+
+* The Cornell box, always (the scene of the Mitsuba speed benchmark): the
+  probe writes its 36 triangles (``--cornell-obj``); 1M rays start at
+  uniform points of [-0.9, 0.9]^3 around the box's centre and go in uniform
+  directions; shadow rays are the same rays cut at distance 0.5.
+* Each mesh given: 1M rays from a sphere around the mesh towards uniform
+  points of its bounding box (shadow rays end at that point).
 
     pip install embreex numpy
     cargo build --release --example trace_probe
     python3 engine/benches/embree_peer.py --probe target/release/examples/trace_probe \\
-        ../shared/data/models/stanford-bunny.obj
+        [../shared/data/models/stanford-bunny.obj]
 
-The rays are drawn from the same distribution, not bit for bit the same
+Embree's figures include the binding's cost of a call per ray (a Cython loop
+around ``rtcIntersect1``/``rtcOccluded1``); the script prints that floor,
+measured on one far-away triangle that no ray comes near, so it can be
+subtracted. The rays are drawn from the same distribution, not bit for bit the same
 rays (numpy's generator, not the probe's).
 """
 import argparse
+import os
 import re
 import subprocess
 import sys
+import tempfile
 import time
 
 RAYS = 1_000_000
@@ -49,8 +59,37 @@ def load_obj(path):
     return v[np.asarray(faces, dtype=np.int64)]
 
 
-def time_embree(triangles):
-    """(closest ns/ray, occluded ns/ray, build ms) of Embree on `triangles`."""
+def mesh_rays(triangles, rng):
+    """Rays from a sphere around `triangles` towards uniform points of their
+    bounding box: (origins, unit directions, distances to those points)."""
+    import numpy as np
+
+    pts = triangles.reshape(-1, 3)
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    centre, radius = (lo + hi) * 0.5, np.linalg.norm(hi - lo)
+    d = rng.normal(size=(RAYS, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    origins = (centre + d * radius).astype(np.float32)
+    targets = (lo + rng.random((RAYS, 3)) * (hi - lo)).astype(np.float32)
+    dirs = targets - origins
+    dists = np.linalg.norm(dirs, axis=1).astype(np.float32)
+    return origins, (dirs / dists[:, None]).astype(np.float32), dists
+
+
+def cornell_rays(rng):
+    """Rays inside the Cornell box in render space (centre at z = -3.9), in
+    uniform directions; shadow rays end at distance 0.5."""
+    import numpy as np
+
+    origins = (rng.random((RAYS, 3)) * 1.8 - 0.9 - [0.0, 0.0, 3.9]).astype(np.float32)
+    d = rng.normal(size=(RAYS, 3))
+    dirs = (d / np.linalg.norm(d, axis=1, keepdims=True)).astype(np.float32)
+    return origins, dirs, np.full(RAYS, 0.5, dtype=np.float32)
+
+
+def time_embree(triangles, rays):
+    """(closest ns/ray, occluded ns/ray, build ms) of Embree on `triangles`
+    for `rays` = (origins, directions, shadow distances)."""
     import numpy as np
     from embreex import rtcore_scene as rtcs
     from embreex.mesh_construction import TriangleMesh
@@ -63,17 +102,7 @@ def time_embree(triangles):
     scene.run(one, one + 1.0, query="OCCLUDED")
     build_ms = (time.perf_counter() - start) * 1e3
 
-    rng = np.random.default_rng(12345)
-    pts = triangles.reshape(-1, 3)
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
-    centre, radius = (lo + hi) * 0.5, np.linalg.norm(hi - lo)
-    d = rng.normal(size=(RAYS, 3))
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    origins = (centre + d * radius).astype(np.float32)
-    targets = (lo + rng.random((RAYS, 3)) * (hi - lo)).astype(np.float32)
-    dirs = targets - origins
-    dists = np.linalg.norm(dirs, axis=1).astype(np.float32)
-    dirs = (dirs / dists[:, None]).astype(np.float32)
+    origins, dirs, dists = rays
 
     best = [float("inf")] * 2
     for _ in range(PASSES):
@@ -88,22 +117,33 @@ def time_embree(triangles):
     return best[0] / RAYS * 1e9, best[1] / RAYS * 1e9, build_ms
 
 
-def time_probe(probe, mesh):
-    """(closest, occluded) ns/ray the probe reports for `mesh`."""
-    out = subprocess.run([probe, mesh], capture_output=True, text=True, check=True).stdout
-    # The probe prints the Cornell box first, then the mesh.
-    times = {}
-    for line in out.splitlines():
-        m = PROBE_RE.match(line)
-        if m:
-            times[m.group(1)] = float(m.group(2))
-    return times["closest"], times["occluded"]
+def time_probe(probe, args):
+    """[(closest, occluded) ns/ray] the probe reports, one pair per scene it
+    measures (the Cornell box first, then the mesh if `args` names one)."""
+    out = subprocess.run([probe, *args], capture_output=True, text=True, check=True).stdout
+    times = [m.group(1, 2) for m in map(PROBE_RE.match, out.splitlines()) if m]
+    pairs = []
+    for (q0, t0), (q1, t1) in zip(times[::2], times[1::2]):
+        assert (q0, q1) == ("closest", "occluded"), out
+        pairs.append((float(t0), float(t1)))
+    return pairs
+
+
+def report(name, triangles, rays, radiant):
+    """Times Embree on `triangles` and prints it against `radiant`'s
+    (closest, occluded) ns/ray."""
+    e_closest, e_occluded, build_ms = time_embree(triangles, rays)
+    for query, e, r in [("closest", e_closest, radiant[0]),
+                        ("occluded", e_occluded, radiant[1])]:
+        print(f"{name:24} {len(triangles):9} {query:>9} {e:10.1f} {r:10.1f} "
+              f"{r / e:14.2f}x")
+    print(f"  embree build {build_ms:.0f} ms", file=sys.stderr)
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--probe", default="target/release/examples/trace_probe")
-    ap.add_argument("meshes", nargs="+")
+    ap.add_argument("meshes", nargs="*")
     args = ap.parse_args()
     try:
         import numpy  # noqa: F401
@@ -111,18 +151,24 @@ def main():
     except ImportError as e:
         print(f"skipping: {e} (pip install embreex numpy)", file=sys.stderr)
         return 0
-    print(f"{'mesh':24} {'triangles':>9} {'query':>9} {'embree ns':>10} "
+    import numpy as np
+
+    rng = np.random.default_rng(12345)
+    far = np.array([[[1e3, 1e3, 1e3], [1e3 + 1e-3, 1e3, 1e3], [1e3, 1e3 + 1e-3, 1e3]]],
+                   dtype=np.float32)
+    floor = time_embree(far, cornell_rays(rng))
+    print(f"embree binding floor (one far-away triangle): {floor[0]:.1f} ns closest, "
+          f"{floor[1]:.1f} ns occluded")
+    print(f"{'scene':24} {'triangles':>9} {'query':>9} {'embree ns':>10} "
           f"{'radiant ns':>10} {'radiant/embree':>15}")
+    with tempfile.TemporaryDirectory() as tmp:
+        obj = os.path.join(tmp, "cornell-box.obj")
+        cornell = time_probe(args.probe, ["--cornell-obj", obj])[0]
+        report("cornell-box", load_obj(obj), cornell_rays(rng), cornell)
     for mesh in args.meshes:
         triangles = load_obj(mesh)
-        e_closest, e_occluded, build_ms = time_embree(triangles)
-        r_closest, r_occluded = time_probe(args.probe, mesh)
-        name = mesh.rsplit("/", 1)[-1]
-        for query, e, r in [("closest", e_closest, r_closest),
-                            ("occluded", e_occluded, r_occluded)]:
-            print(f"{name:24} {len(triangles):9} {query:>9} {e:10.1f} {r:10.1f} "
-                  f"{r / e:14.2f}x")
-        print(f"  embree build {build_ms:.0f} ms", file=sys.stderr)
+        radiant = time_probe(args.probe, [mesh])[1]
+        report(mesh.rsplit("/", 1)[-1], triangles, mesh_rays(triangles, rng), radiant)
     return 0
 
 

@@ -13,16 +13,22 @@
 //! Each query runs over the same rays several times; the fastest pass is
 //! reported, which keeps noise from other processes out of the numbers.
 //!
+//! `--cornell-obj OUT.obj` also writes the Cornell box's triangles as the
+//! probe traces them (render space) to an OBJ file, so that
+//! `engine/benches/embree_peer.py --cornell` can time Embree on the same
+//! triangles with the same ray distribution.
+//!
 //! ```text
-//! cargo run --release --example trace_probe [-- path/to/mesh.obj]
+//! cargo run --release --example trace_probe [-- [--cornell-obj OUT.obj] path/to/mesh.obj]
 //! ```
 
 use anyhow::{Context, Result};
 use glam::Vec3;
 use radiant::accel::{Accel, BuildQuality, Hit, Primitive};
 use radiant::extract::{Overrides, extract};
+use std::fmt::Write as _;
 use std::hint::black_box;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Rays per measurement pass.
@@ -107,12 +113,30 @@ fn measure(name: &str, accel: &Accel, closest: &[Query], shadow: &[Query]) {
     );
 }
 
+/// Writes the triangles of `prims` as an OBJ file (three vertices per face).
+fn write_obj(prims: &[Primitive], path: &Path) -> Result<()> {
+    let mut obj = String::new();
+    for (face, prim) in prims.iter().enumerate() {
+        let Primitive::Triangle(v) = prim else {
+            anyhow::bail!("the scene has a non-triangle primitive; OBJ holds triangles only");
+        };
+        for p in v {
+            writeln!(obj, "v {} {} {}", p.x, p.y, p.z)?;
+        }
+        writeln!(obj, "f {} {} {}", face * 3 + 1, face * 3 + 2, face * 3 + 3)?;
+    }
+    std::fs::write(path, obj).with_context(|| format!("writing {}", path.display()))
+}
+
 /// Rays inside the Cornell box (render space puts the camera at the origin
-/// and the box's centre at z = -3.9).
-fn cornell(rng: &mut Lcg) -> Result<()> {
+/// and the box's centre at z = -3.9); writes its triangles to `obj` if given.
+fn cornell(rng: &mut Lcg, obj: Option<&Path>) -> Result<()> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/cornell-box.yaml");
     let scene = radiant::scene::load(&path)?;
     let render = extract(&scene, &radiant::builtin_registry(), &Overrides::default())?;
+    if let Some(obj) = obj {
+        write_obj(render.accel.primitives(), obj)?;
+    }
     let closest: Vec<Query> = (0..RAYS)
         .map(|_| {
             let o = (rng.vec3() * 1.8 - 0.9) - Vec3::new(0.0, 0.0, 3.9);
@@ -159,10 +183,25 @@ fn mesh(path: &Path, rng: &mut Lcg) -> Result<()> {
 }
 
 fn main() -> Result<()> {
+    let mut args = std::env::args_os().skip(1);
+    let mut cornell_obj: Option<PathBuf> = None;
+    let mut mesh_path: Option<PathBuf> = None;
+    while let Some(arg) = args.next() {
+        if arg == "--cornell-obj" {
+            let out = args.next().context("--cornell-obj needs an output path")?;
+            cornell_obj = Some(out.into());
+        } else if mesh_path.is_none() {
+            mesh_path = Some(arg.into());
+        } else {
+            anyhow::bail!(
+                "unexpected argument {arg:?}; usage: trace_probe [--cornell-obj OUT.obj] [MESH.obj]"
+            );
+        }
+    }
     let mut rng = Lcg(12345);
-    cornell(&mut rng).context("Cornell box benchmark")?;
-    if let Some(path) = std::env::args_os().nth(1) {
-        mesh(Path::new(&path), &mut rng).context("mesh benchmark")?;
+    cornell(&mut rng, cornell_obj.as_deref()).context("Cornell box benchmark")?;
+    if let Some(path) = mesh_path {
+        mesh(&path, &mut rng).context("mesh benchmark")?;
     }
     Ok(())
 }
