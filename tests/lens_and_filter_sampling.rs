@@ -142,11 +142,35 @@ fn filter_importance_sampling_matches_the_normalised_absolute_filter() {
             wrong_sign * 100 < drawn.len(),
             "{name}: {wrong_sign} weights of the wrong sign"
         );
-        // pdf() agrees with the tabulated density where the samples land.
-        for (p, _) in drawn.iter().take(1000) {
-            let tabulated = sampler.pdf(*p) as f64;
-            assert!(tabulated > 0.0, "{name}: zero pdf at a sample {p}");
+        // pdf() is |f| at the centre of the cell holding the offset over the
+        // tabulated ∫|f| (the piecewise-constant density `sample` draws from).
+        let res = FilterSampler::DEFAULT_RESOLUTION;
+        let cell = 2.0 * r / res as f32;
+        for (p, _) in drawn.iter().take(2000) {
+            let centre = ((*p + Vec2::splat(r)) / cell)
+                .floor()
+                .min(Vec2::splat(res as f32 - 1.0))
+                * cell
+                + Vec2::splat(0.5 * cell - r);
+            let expected = f.eval(centre.x, centre.y).abs() as f64 / sampler.abs_integral() as f64;
+            let pdf = sampler.pdf(*p) as f64;
+            assert!(
+                pdf > 0.0 && (pdf / expected - 1.0).abs() < 1e-3,
+                "{name}: pdf {pdf} at {p}, expected {expected}"
+            );
         }
+        // … and it integrates to one over the support (midpoint rule on a
+        // grid finer than the table's cells).
+        let n = 4 * res;
+        let h = 2.0 * r / n as f32;
+        let total: f64 = (0..n * n)
+            .map(|i| {
+                let p = Vec2::new((i % n) as f32 + 0.5, (i / n) as f32 + 0.5) * h - Vec2::splat(r);
+                sampler.pdf(p) as f64
+            })
+            .sum::<f64>()
+            * (h * h) as f64;
+        assert!((total - 1.0).abs() < 1e-3, "{name}: ∫ pdf = {total}");
         assert_eq!(sampler.pdf(Vec2::splat(r * 1.01)), 0.0);
     }
 }

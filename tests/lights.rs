@@ -20,12 +20,17 @@ const SPHERE: BoundingSphere = BoundingSphere {
 };
 
 fn sky(rotation: Mat3) -> EnvironmentLight {
+    sky_around(rotation, SPHERE)
+}
+
+/// The sky map around a scene bounded by `sphere`.
+fn sky_around(rotation: Mat3, sphere: BoundingSphere) -> EnvironmentLight {
     let map = read_exr(root().join("scenes/environment-sky.exr")).expect("sky map");
     EnvironmentLight::from_pixels(
         map.pixels,
         UVec2::new(map.width, map.height),
         rotation,
-        SPHERE,
+        sphere,
     )
     .expect("valid map")
 }
@@ -116,7 +121,7 @@ fn environment_samples_agree_with_eval_and_lie_outside_the_scene() {
         assert!(s.pdf > 0.0, "the map has no black pixels");
         assert_eq!(s.n, Vec3::ZERO);
         // pbrt's convention: p = reference + wi · 2r, outside the sphere.
-        assert!(((s.p - origin).length() - 2.0).abs() < 1e-5);
+        assert!(((s.p - origin).length() - 2.0 * SPHERE.radius).abs() < 1e-5);
         assert!(s.p.length() > SPHERE.radius);
         let e = eval(&light, (s.p - origin).normalize());
         let close = |a: f32, b: f32| (a - b).abs() <= 2e-3 * a.abs().max(b.abs()) + 1e-6;
@@ -134,7 +139,13 @@ fn environment_samples_agree_with_eval_and_lie_outside_the_scene() {
 
 #[test]
 fn environment_power_is_pi_r2_times_the_integral_of_luminance() {
-    let light = sky(Mat3::IDENTITY);
+    // A radius other than 1 and a centre off the origin, so that a missing
+    // r² or a centre in the formula would show.
+    let sphere = BoundingSphere {
+        centre: Vec3::new(1.0, -2.0, 3.0),
+        radius: 2.5,
+    };
+    let light = sky_around(Mat3::IDENTITY, sphere);
     let n = 400usize;
     let mut sum = 0.0f64;
     for i in 0..n {
@@ -148,7 +159,8 @@ fn environment_power_is_pi_r2_times_the_integral_of_luminance() {
         }
     }
     let integral = sum * 4.0 * std::f64::consts::PI / (2 * n * n) as f64;
-    let expected = std::f64::consts::PI * integral;
+    let r = sphere.radius as f64;
+    let expected = std::f64::consts::PI * r * r * integral;
     let power = light.power() as f64;
     assert!(
         (power / expected - 1.0).abs() < 0.02,

@@ -141,7 +141,38 @@ fn wrong_value_types() {
     fails_at(
         &format!("{CAMERA}shapes:\n  - type: cube\n    transform: {{translate: [1, 2]}}\n"),
         4,
-        &[],
+        &["expected a list of 3 numbers, found 2"],
+    );
+    // Fixed-length lists reject extra elements too (the YAML deserializer
+    // alone would drop them unnoticed).
+    fails_at(
+        &format!("{CAMERA}shapes:\n  - type: cube\n    transform: {{translate: [1, 2, 3, 4]}}\n"),
+        4,
+        &["expected a list of 3 numbers, found 4"],
+    );
+    fails_at(
+        &format!(
+            "{CAMERA}shapes:\n  - type: cube\n    transform:\n      rotate: {{axis: [0, 1, 0, 0], angle: 9}}\n"
+        ),
+        5,
+        &["axis", "3 numbers, found 4"],
+    );
+    fails_at(
+        "camera:\n  type: perspective\n  look_at: {origin: [0, 0, 4, [1]], target: [0, 0, 0]}\n",
+        3,
+        &["origin"],
+    );
+    fails_at(
+        &format!(
+            "{CAMERA}shapes:\n  - type: cube\n    transform:\n      matrix: [[1, 0, 0, 0, 9], [0, 1, 0, 0], [0, 0, 1, 0]]\n"
+        ),
+        5,
+        &["4 numbers, found 5"],
+    );
+    fails_at(
+        &format!("{CAMERA}lights:\n  - {{type: point, position: [0, 1, 2, 3]}}\n"),
+        3,
+        &["3 numbers, found 4"],
     );
     fails_at(
         "camera:\n  type: perspective\n  fov: 180\n",
@@ -187,6 +218,16 @@ fn misplaced_modules() {
         3,
         &["must be attached to a shape"],
     );
+    for light in [
+        "{type: point, position: [0, 1, 0], intensity: 1}",
+        "{type: environment, radiance: 5}",
+    ] {
+        fails_at(
+            &format!("{CAMERA}shapes:\n  - type: cube\n    emitter: {light}\n"),
+            4,
+            &["a shape's `emitter` must be a light that emits from the shape's surface"],
+        );
+    }
     fails_at(
         &format!("{CAMERA}shapes:\n  - type: sphere\n    transform: {{scale: [1, 2, 1]}}\n"),
         3,
@@ -283,4 +324,86 @@ fn unknown_filter_sampling_lists_the_allowed_ones() {
         3,
         &["importnce", "splat", "importance"],
     );
+}
+
+#[test]
+fn out_of_range_values_are_rejected_where_written() {
+    for value in ["2", "-0.5", "[0.5, 1.5, 0.5]", "1e39"] {
+        fails_at(
+            &format!("{CAMERA}materials:\n  m: {{type: diffuse, reflectance: {value}}}\n"),
+            3,
+            &["`reflectance` must lie in [0, 1]"],
+        );
+    }
+    for value in ["-1", "[1, -2, 1]", "1e39"] {
+        fails_at(
+            &format!(
+                "{CAMERA}shapes:\n  - type: rectangle\n    emitter: {{type: area, radiance: {value}}}\n"
+            ),
+            4,
+            &["`radiance` must be finite and non-negative"],
+        );
+    }
+    fails_at(
+        &format!("{CAMERA}film:\n  filter: {{type: box, radius: 1e12}}\n"),
+        3,
+        &["`radius` must be from 0.5 to 32 pixels"],
+    );
+}
+
+#[test]
+fn deeply_nested_named_materials_are_an_error_not_a_stack_overflow() {
+    let mut text = format!("{CAMERA}materials:\n");
+    for i in 0..200 {
+        text += &format!(
+            "  m{i}: {{type: bump, height: 0.5, material: m{}}}\n",
+            i + 1
+        );
+    }
+    text += "  m200: {type: diffuse}\nshapes:\n  - {type: cube, material: m0}\n";
+    // m0 → … → m31 are 32 levels; m31's reference to m32 (line 34) is one
+    // too many.
+    fails_at(&text, 34, &["nested more than 32 materials deep"]);
+}
+
+#[test]
+fn overrides_outside_the_allowed_ranges_are_errors() {
+    let scene = from_str(CAMERA, Path::new("scenes/bad.yaml"), &radiant_tests::root())
+        .expect("the scene parses");
+    let registry = radiant::builtin_registry();
+    for (overrides, needle) in [
+        (
+            Overrides {
+                width: Some(40_000),
+                ..Default::default()
+            },
+            "width override must be between 1 and 32768",
+        ),
+        (
+            Overrides {
+                height: Some(0),
+                ..Default::default()
+            },
+            "height override must be between 1 and 32768",
+        ),
+        (
+            Overrides {
+                spp: Some(0),
+                ..Default::default()
+            },
+            "spp override",
+        ),
+        (
+            Overrides {
+                max_depth: Some(-2),
+                ..Default::default()
+            },
+            "max_depth override",
+        ),
+    ] {
+        let Err(err) = extract(&scene, &registry, &overrides) else {
+            panic!("{overrides:?} should be rejected");
+        };
+        assert!(err.to_string().contains(needle), "{err}");
+    }
 }

@@ -209,7 +209,7 @@ fn delta_lobes_follow_fresnel() {
     let u: Vec<Vec3> = (0..SAMPLES)
         .map(|_| Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()))
         .collect();
-    let f = 0.089_171f64;
+    let f = 0.089_186_7f64;
     let mut reflected = 0usize;
     for b in s.sample(wo, &u) {
         assert!(b.delta);
@@ -245,6 +245,158 @@ fn delta_lobes_follow_fresnel() {
         let e = shader(yaml).eval(direction(0.5, 0.0), direction(0.5, std::f32::consts::PI));
         assert_eq!(e.value, Rgb::ZERO, "{yaml}");
     }
+}
+
+/// Unpolarised Fresnel reflectance of a dielectric interface at incidence
+/// cosine `cos_i` > 0 with relative index `eta` (written out here, apart
+/// from the shaders' own implementation).
+fn fresnel_dielectric(cos_i: f64, eta: f64) -> f64 {
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+/// Unpolarised Fresnel reflectance of a conductor with complex index
+/// `eta + i k` at incidence cosine `cos_i` (complex arithmetic written out).
+fn fresnel_conductor(cos_i: f64, eta: f64, k: f64) -> f64 {
+    type C = (f64, f64);
+    let mul = |a: C, b: C| (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0);
+    let div = |a: C, b: C| {
+        let d = b.0 * b.0 + b.1 * b.1;
+        ((a.0 * b.0 + a.1 * b.1) / d, (a.1 * b.0 - a.0 * b.1) / d)
+    };
+    let sqrt = |a: C| {
+        let r = (a.0 * a.0 + a.1 * a.1).sqrt();
+        let re = ((r + a.0) * 0.5).sqrt();
+        let im = ((r - a.0) * 0.5).sqrt().copysign(a.1);
+        (re, im)
+    };
+    let n: C = (eta, k);
+    let sin2_t = div(((1.0 - cos_i * cos_i), 0.0), mul(n, n));
+    let cos_t = sqrt((1.0 - sin2_t.0, -sin2_t.1));
+    let n_cos_i = (n.0 * cos_i, n.1 * cos_i);
+    let n_cos_t = mul(n, cos_t);
+    let r_parallel = div(
+        (n_cos_i.0 - cos_t.0, n_cos_i.1 - cos_t.1),
+        (n_cos_i.0 + cos_t.0, n_cos_i.1 + cos_t.1),
+    );
+    let r_perpendicular = div(
+        (cos_i - n_cos_t.0, -n_cos_t.1),
+        (cos_i + n_cos_t.0, n_cos_t.1),
+    );
+    let norm2 = |a: C| a.0 * a.0 + a.1 * a.1;
+    0.5 * (norm2(r_parallel) + norm2(r_perpendicular))
+}
+
+#[test]
+fn the_reference_fresnel_formulas_match_known_values() {
+    // Glass at normal incidence: ((1.5 − 1)/(1.5 + 1))² = 0.04; at cos 0.5
+    // the value `delta_lobes_follow_fresnel` uses.
+    assert!((fresnel_dielectric(1.0, 1.5) - 0.04).abs() < 1e-12);
+    assert!((fresnel_dielectric(0.5, 1.5) - 0.089_186_7).abs() < 1e-7);
+    // A conductor at normal incidence: ((n − 1)² + k²)/((n + 1)² + k²).
+    let (n, k) = (0.2, 3.0);
+    let normal = ((n - 1.0f64).powi(2) + k * k) / ((n + 1.0f64).powi(2) + k * k);
+    assert!((fresnel_conductor(1.0, n, k) - normal).abs() < 1e-12);
+    // With k = 0 it is the dielectric formula.
+    assert!((fresnel_conductor(0.3, 1.5, 0.0) - fresnel_dielectric(0.3, 1.5)).abs() < 1e-12);
+}
+
+/// The fraction of `samples` that reflect (wi.z > 0), as (fraction, 5σ
+/// bound) for an expected probability `p`.
+fn reflected_fraction(samples: &[radiant_core::BsdfSample], p: f64) -> (f64, f64) {
+    let reflected = samples.iter().filter(|b| b.wi.z > 0.0).count();
+    let n = samples.len() as f64;
+    (
+        reflected as f64 / n,
+        5.0 * (p * (1.0 - p) / n).sqrt() + 1e-12,
+    )
+}
+
+#[test]
+fn delta_lobes_split_as_fresnel_says_at_every_angle() {
+    let mut rng = Rng::new(17);
+    let u: Vec<Vec3> = (0..SAMPLES)
+        .map(|_| Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()))
+        .collect();
+    let glass = shader("{type: dielectric, int_ior: 1.5, ext_ior: 1}");
+    let thin = shader("{type: thin_dielectric, int_ior: 1.5, ext_ior: 1}");
+    for cos in [0.05f32, 0.2, 0.5, 0.8, 0.99] {
+        let wo = direction(cos, 1.1);
+        let f = fresnel_dielectric(cos as f64, 1.5);
+        let samples = glass.sample(wo, &u);
+        let (frac, bound) = reflected_fraction(&samples, f);
+        assert!(
+            (frac - f).abs() < bound,
+            "glass at cos {cos}: {frac} vs {f}"
+        );
+        for b in samples.iter().filter(|b| b.wi.z > 0.0) {
+            assert!(
+                (b.pdf as f64 - f).abs() < 1e-5,
+                "glass at cos {cos}: {} vs {f}",
+                b.pdf
+            );
+        }
+
+        // A thin slab sums its internal reflections: R = F + (1−F)²F/(1−F²).
+        let slab = f + (1.0 - f) * (1.0 - f) * f / (1.0 - f * f);
+        let samples = thin.sample(wo, &u);
+        let (frac, bound) = reflected_fraction(&samples, slab);
+        assert!(
+            (frac - slab).abs() < bound,
+            "thin at cos {cos}: {frac} vs {slab}"
+        );
+        for b in &samples {
+            assert!(b.delta);
+            if b.wi.z > 0.0 {
+                assert!((b.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-5);
+                assert!((b.pdf as f64 - slab).abs() < 1e-5, "{}", b.pdf);
+            } else {
+                assert!(
+                    (b.wi + wo).length() < 1e-6,
+                    "a thin slab passes light straight"
+                );
+                assert!((b.pdf as f64 - (1.0 - slab)).abs() < 1e-5, "{}", b.pdf);
+            }
+            assert!(
+                (b.weight - Rgb::ONE).abs().max_element() < 1e-5,
+                "{}",
+                b.weight
+            );
+        }
+    }
+}
+
+#[test]
+fn smooth_conductors_reflect_the_fresnel_fraction() {
+    let u = [Vec3::splat(0.5)];
+    for (eta, k) in [(0.2f32, 3.0f32), (1.5, 0.5), (0.05, 4.0)] {
+        let s = shader(&format!("{{type: conductor, eta: {eta}, k: {k}}}"));
+        for cos in [0.05f32, 0.3, 0.7, 1.0] {
+            let wo = direction(cos, 0.3);
+            let b = s.sample(wo, &u)[0];
+            let f = fresnel_conductor(cos as f64, eta as f64, k as f64);
+            assert!(b.delta);
+            assert!((b.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-5);
+            assert!(
+                (b.weight - Rgb::splat(f as f32)).abs().max_element() < 1e-4,
+                "eta {eta}, k {k}, cos {cos}: weight {} vs Fresnel {f}",
+                b.weight
+            );
+        }
+    }
+    // Named metals give per-channel weights below 1 and not all equal.
+    let b = shader("{type: conductor, material: Au}").sample(direction(0.7, 0.0), &u)[0];
+    assert!(
+        b.weight.max_element() < 1.0 && b.weight.x > b.weight.z,
+        "{}",
+        b.weight
+    );
 }
 
 #[test]

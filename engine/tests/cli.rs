@@ -379,3 +379,117 @@ fn accuracy_reference_of_another_size_is_rejected() {
     args.extend_from_slice(SMALL);
     accuracy_fails_with(&args, &["8x8", "16x16", "--width"]);
 }
+
+#[test]
+fn out_of_range_arguments_are_refused_with_the_allowed_range() {
+    let (_dir, out) = temp("x.exr");
+    let out = out.to_str().unwrap();
+    for (flag, value, range) in [
+        ("--width", "10000000", "1..=32768"),
+        ("--height", "40000", "1..=32768"),
+        ("--threads", "10000", "1..=1024"),
+        ("--spp", "0", "1.."),
+        ("--max-depth", "-2", "-1.."),
+    ] {
+        let o = radiant(&["render", "scenes/cornell-box.yaml", "-o", out, flag, value]);
+        assert_eq!(o.status.code(), Some(2), "{flag} {value}: {}", stderr(&o));
+        let err = stderr(&o);
+        assert!(err.contains(flag) && err.contains(range), "{err}");
+        assert!(!Path::new(out).exists());
+    }
+    let o = radiant(&["accuracy", "scenes/cornell-box.yaml", "--width", "40000"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
+#[test]
+fn output_paths_that_cannot_be_files_are_refused_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path().join("image.png");
+    std::fs::create_dir(&folder).unwrap();
+    let o = radiant(&[
+        "render",
+        "scenes/cornell-box.yaml",
+        "-o",
+        folder.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("it is a folder"), "{}", stderr(&o));
+
+    let file = dir.path().join("plain");
+    std::fs::write(&file, "").unwrap();
+    let inside = file.join("x.png");
+    let o = radiant(&[
+        "render",
+        "scenes/cornell-box.yaml",
+        "-o",
+        inside.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("is not a folder"), "{}", stderr(&o));
+}
+
+#[test]
+fn a_scene_of_only_a_camera_and_a_sky_renders_the_sky() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("sky.yaml");
+    std::fs::write(
+        &scene,
+        "camera: {type: perspective}\nlights:\n  - {type: environment, radiance: 0.25}\n",
+    )
+    .unwrap();
+    let out = dir.path().join("sky.exr");
+    let o = radiant(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--spp",
+        "2",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let image = radiant::film::output::read_exr(&out).unwrap();
+    for p in &image.pixels {
+        assert!(
+            (p.x - 0.25).abs() < 1e-6 && (p.z - 0.25).abs() < 1e-6,
+            "{p}"
+        );
+    }
+}
+
+#[test]
+fn compare_refuses_non_finite_images_and_names_both_sizes() {
+    use radiant::film::Image;
+    use radiant_core::Rgb;
+    let dir = tempfile::tempdir().unwrap();
+    let (nan, one, wide) = (
+        dir.path().join("nan.exr"),
+        dir.path().join("one.exr"),
+        dir.path().join("wide.exr"),
+    );
+    let image = |width, value| Image {
+        width,
+        height: 2,
+        pixels: vec![Rgb::splat(value); width as usize * 2],
+    };
+    radiant::film::output::write(&nan, &image(2, f32::NAN)).unwrap();
+    radiant::film::output::write(&one, &image(2, 1.0)).unwrap();
+    radiant::film::output::write(&wide, &image(3, 1.0)).unwrap();
+    let o = radiant(&["compare", nan.to_str().unwrap(), one.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("4 pixels are NaN or infinite"),
+        "{}",
+        stderr(&o)
+    );
+    let o = radiant(&["compare", one.to_str().unwrap(), wide.to_str().unwrap()]);
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert!(
+        err.contains("one.exr` is 2x2") && err.contains("wide.exr` is 3x2"),
+        "{err}"
+    );
+}

@@ -2,6 +2,7 @@
 //! and write the CSV, plot and summary (see `radiant::accuracy`).
 
 use super::diagnostic::report;
+use super::film_args::FilmArgs;
 use clap::Args;
 use radiant::Registry;
 use radiant::accuracy::{self, AccuracyError, Axis, Config, Reference};
@@ -38,15 +39,8 @@ pub struct AccuracyArgs {
     /// Seed of the first setting (the reference's seeds are fixed apart).
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Film width in pixels.
-    #[arg(long)]
-    width: Option<u32>,
-    /// Film height in pixels.
-    #[arg(long)]
-    height: Option<u32>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    film: FilmArgs,
 }
 
 fn seconds(name: &str, value: f64) -> miette::Result<Duration> {
@@ -88,20 +82,8 @@ pub fn run(registry: &Registry, args: &AccuracyArgs) -> miette::Result<()> {
         Some(t) => seconds("reference-time", t)?,
         None => budget,
     };
-    for (name, value) in [
-        ("max-spp", Some(args.max_spp)),
-        ("width", args.width),
-        ("height", args.height),
-    ] {
-        if value == Some(0) {
-            miette::bail!("--{name} must be at least 1");
-        }
-    }
     if args.max_spp < 2 {
         miette::bail!("--max-spp must be at least 2 (each setting renders two halves)");
-    }
-    if args.threads == Some(0) {
-        miette::bail!("--threads must be at least 1");
     }
     if args.out.exists() && !args.out.is_dir() {
         miette::bail!("--out `{}` exists and is not a folder", args.out.display());
@@ -112,8 +94,8 @@ pub fn run(registry: &Registry, args: &AccuracyArgs) -> miette::Result<()> {
         max_spp: args.max_spp,
         axes: axes(&args.only)?,
         overrides: Overrides {
-            width: args.width,
-            height: args.height,
+            width: args.film.width,
+            height: args.film.height,
             ..Default::default()
         },
         seed: args.seed,
@@ -125,10 +107,7 @@ pub fn run(registry: &Registry, args: &AccuracyArgs) -> miette::Result<()> {
         .map(Reference::read)
         .transpose()
         .map_err(error)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0))
-        .build()
-        .map_err(|e| miette::miette!("cannot start worker threads: {e}"))?;
+    let pool = args.film.thread_pool()?;
     let log = |line: &str| eprintln!("{line}");
     let result = pool.install(|| accuracy::run(&mut scene, registry, &config, reference, &log));
     let result = result.map_err(error)?;

@@ -2,6 +2,7 @@
 
 mod accuracy;
 mod diagnostic;
+mod film_args;
 mod info;
 mod modules;
 mod render;
@@ -71,19 +72,35 @@ pub fn run() -> ExitCode {
 
 fn compare(image: &std::path::Path, reference: &std::path::Path) -> miette::Result<()> {
     use radiant::film::output::read_exr;
-    let a = read_exr(image).map_err(|e| miette::miette!("{e}"))?;
-    let b = read_exr(reference).map_err(|e| miette::miette!("{e}"))?;
+    let read = |path: &std::path::Path| {
+        let img = read_exr(path).map_err(|e| miette::miette!("{e}"))?;
+        let bad = img.pixels.iter().filter(|p| !p.is_finite()).count();
+        if bad > 0 {
+            miette::bail!(
+                "`{}`: {bad} pixels are NaN or infinite; compare needs finite images",
+                path.display()
+            );
+        }
+        Ok(img)
+    };
+    let (a, b) = (read(image)?, read(reference)?);
     let c = radiant::compare::compare(&a, &b).ok_or_else(|| {
         miette::miette!(
-            "the images differ in size: {}x{} and {}x{}",
+            "the images differ in size: `{}` is {}x{} and `{}` is {}x{}",
+            image.display(),
             a.width,
             a.height,
+            reference.display(),
             b.width,
             b.height
         )
     })?;
     println!("rmse {:.6}", c.rmse);
     println!("relative_mse {:.6}", c.relative_mse);
-    println!("mean_ratio {:.6}", c.mean_ratio);
+    if c.mean_ratio.is_finite() {
+        println!("mean_ratio {:.6}", c.mean_ratio);
+    } else {
+        println!("mean_ratio undefined (the reference's mean is 0)");
+    }
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! `radiant render`: render a scene to an image file.
 
 use super::diagnostic::report;
+use super::film_args::FilmArgs;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use radiant::Registry;
@@ -16,24 +17,17 @@ pub struct RenderArgs {
     /// Output image: .png (tone-mapped sRGB) or .exr (linear float RGB).
     #[arg(short, long)]
     output: PathBuf,
-    /// Samples per pixel (overrides the scene's sampler).
-    #[arg(long)]
+    /// Samples per pixel, at least 1 (overrides the scene's sampler).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     spp: Option<u32>,
     /// Longest path in segments; -1 for unlimited (overrides the scene).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(i32).range(-1..))]
     max_depth: Option<i32>,
     /// Sampler seed.
     #[arg(long)]
     seed: Option<u64>,
-    /// Film width in pixels.
-    #[arg(long)]
-    width: Option<u32>,
-    /// Film height in pixels.
-    #[arg(long)]
-    height: Option<u32>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    film: FilmArgs,
 }
 
 /// Renders as the arguments say.
@@ -49,49 +43,39 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
             args.output.display()
         );
     }
-    if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty())
-        && !dir.is_dir()
-    {
-        miette::bail!(
-            "cannot write `{}`: the folder `{}` does not exist",
-            args.output.display(),
-            dir.display()
-        );
+    if args.output.is_dir() {
+        miette::bail!("cannot write `{}`: it is a folder", args.output.display());
     }
-    for (name, value) in [
-        ("spp", args.spp),
-        ("width", args.width),
-        ("height", args.height),
-    ] {
-        if value == Some(0) {
-            miette::bail!("--{name} must be at least 1");
+    if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.exists() {
+            miette::bail!(
+                "cannot write `{}`: the folder `{}` does not exist",
+                args.output.display(),
+                dir.display()
+            );
         }
-    }
-    if let Some(d) = args.max_depth
-        && d < -1
-    {
-        miette::bail!("--max-depth must be -1 (unlimited) or at least 0, found {d}");
-    }
-    if args.threads == Some(0) {
-        miette::bail!("--threads must be at least 1");
+        if !dir.is_dir() {
+            miette::bail!(
+                "cannot write `{}`: `{}` is not a folder",
+                args.output.display(),
+                dir.display()
+            );
+        }
     }
     let scene = radiant::scene::load(&args.scene).map_err(report)?;
     let overrides = Overrides {
         spp: args.spp,
         max_depth: args.max_depth,
         seed: args.seed,
-        width: args.width,
-        height: args.height,
+        width: args.film.width,
+        height: args.film.height,
         ..Default::default()
     };
     let render_scene = extract(&scene, registry, &overrides).map_err(report)?;
     for (shape, what) in &render_scene.stats.repaired_shapes {
         eprintln!("warning: {shape}: {}", what.describe());
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0))
-        .build()
-        .map_err(|e| miette::miette!("cannot start worker threads: {e}"))?;
+    let pool = args.film.thread_pool()?;
 
     let s = &render_scene.settings;
     let bar = ProgressBar::new(s.width as u64 * s.height as u64 * s.spp as u64);

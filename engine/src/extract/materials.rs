@@ -5,7 +5,7 @@
 //! A nested material is built afresh for every reference (shaders are
 //! small), so the same definition may appear in several wrappers. A stack
 //! of the named materials being built catches a material that contains
-//! itself.
+//! itself, and bounds how deep named materials may nest.
 
 use crate::scene::{Scene, module_error, module_spec};
 use marked_yaml::Node;
@@ -13,6 +13,10 @@ use radiant_core::registry::ModuleType;
 use radiant_core::{BuildContext, MaterialSource, ModuleKind, ParamError, Registry, Shader};
 use std::cell::RefCell;
 use std::collections::BTreeSet;
+
+/// How deep named materials may nest (a `bump` of a `blend` of … ):
+/// deeper chains are an error rather than a stack overflow.
+const MAX_NESTING: usize = 32;
 
 /// Builds nested materials for one extract.
 pub(super) struct NestedMaterials<'s> {
@@ -100,6 +104,15 @@ impl MaterialSource for NestedMaterials<'_> {
                 return Err(ParamError::at(
                     node.span(),
                     format!("material `{name}` contains itself: {cycle}"),
+                ));
+            }
+            if self.stack.borrow().len() >= MAX_NESTING {
+                return Err(ParamError::at(
+                    node.span(),
+                    format!(
+                        "material `{name}` is nested more than {MAX_NESTING} materials deep; \
+                         at most {MAX_NESTING} levels of named materials are allowed"
+                    ),
                 ));
             }
             (

@@ -14,7 +14,9 @@ mod shapes;
 pub use lights::LightTable;
 
 use crate::accel::{Accel, BuildQuality, Primitive};
-use crate::scene::{LightSelection, RenderSettings, Scene, SceneError, module_error};
+use crate::scene::{
+    LightSelection, MAX_FILM_SIZE, RenderSettings, Scene, SceneError, module_error,
+};
 use crate::world::{
     CameraPose, EmitterSpec, FlippedNormals, Geometry, LightSpec, MaterialRef, MeshRepairs,
     ModuleSpec, Name, Transform,
@@ -28,6 +30,7 @@ use radiant_core::{
 };
 use shapes::{ShapePrim, tessellate};
 use std::collections::{BTreeSet, HashMap};
+use std::path::Path;
 use std::time::Duration;
 
 /// Command-line overrides of the scene's settings.
@@ -141,6 +144,31 @@ impl Builder<'_> {
     }
 }
 
+/// Rejects overrides outside the ranges a scene file allows.
+fn check_overrides(file: &Path, o: &Overrides) -> Result<(), SceneError> {
+    let error = |what: String| Err(SceneError::new(file, None, what));
+    for (key, value) in [("width", o.width), ("height", o.height)] {
+        if let Some(v) = value
+            && !(1..=MAX_FILM_SIZE).contains(&v)
+        {
+            return error(format!(
+                "the film {key} override must be between 1 and {MAX_FILM_SIZE} pixels, found {v}"
+            ));
+        }
+    }
+    if o.spp == Some(0) {
+        return error("the spp override must be at least 1".into());
+    }
+    if let Some(d) = o.max_depth
+        && d < -1
+    {
+        return error(format!(
+            "the max_depth override must be -1 (unlimited) or at least 0, found {d}"
+        ));
+    }
+    Ok(())
+}
+
 /// Builds the render data of `scene`'s current frame.
 pub fn extract(
     scene: &Scene,
@@ -148,6 +176,7 @@ pub fn extract(
     overrides: &Overrides,
 ) -> Result<RenderScene, SceneError> {
     let file = &scene.file;
+    check_overrides(file, overrides)?;
     let mut settings = scene.settings;
     settings.spp = overrides.spp.unwrap_or(settings.spp);
     settings.max_depth = overrides.max_depth.unwrap_or(settings.max_depth);
@@ -255,6 +284,21 @@ pub fn extract(
                     }
                 }
                 let light = b.build::<dyn Light>(spec, &mut ctx!(Some(&shape)))?;
+                let effects = light.effects();
+                if light.is_delta()
+                    || !effects.contains(Effects::AREA_LIGHTS)
+                    || effects.contains(Effects::ENVIRONMENT)
+                {
+                    return Err(SceneError::new(
+                        file,
+                        spec.location,
+                        format!(
+                            "a shape's `emitter` must be a light that emits from the shape's \
+                             surface (such as `area`); `{}` does not — put it under `lights:`",
+                            spec.type_name
+                        ),
+                    ));
+                }
                 lights.push(light);
                 stats.emissive_shapes += 1;
                 (lights.len() - 1) as u32

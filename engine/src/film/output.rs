@@ -135,22 +135,14 @@ fn write_exr(file: &mut std::fs::File, image: &Image) -> Result<(), String> {
 
 /// Reads the RGB channels of an EXR file as linear floats.
 pub fn read_exr(path: impl AsRef<Path>) -> Result<Image, ImageError> {
-    use exr::prelude::read_first_rgba_layer_from_file;
     let path = path.as_ref();
-    let image = read_first_rgba_layer_from_file(
-        path,
-        |resolution, _| Image {
-            width: resolution.width() as u32,
-            height: resolution.height() as u32,
-            pixels: vec![radiant_core::Rgb::ZERO; resolution.width() * resolution.height()],
-        },
-        |image: &mut Image, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            let i = pos.y() * image.width as usize + pos.x();
-            image.pixels[i] = radiant_core::Rgb::new(r, g, b);
-        },
-    )
-    .map_err(|e| io_error(path, e))?;
-    Ok(image.layer_data.channel_data.pixels)
+    let (pixels, size) =
+        radiant_core::exr_file::read_exr_rgb(path).map_err(|e| io_error(path, e))?;
+    Ok(Image {
+        width: size.x,
+        height: size.y,
+        pixels,
+    })
 }
 
 #[cfg(test)]

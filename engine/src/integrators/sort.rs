@@ -14,6 +14,11 @@ pub(crate) fn sort_by_key(
 ) {
     offsets.clear();
     offsets.resize(keys + 1, 0);
+    if keys == 0 {
+        // No keys (a scene without materials): nothing can be sorted.
+        debug_assert!(items.is_empty(), "items need keys");
+        return;
+    }
     let counts = &mut offsets[..];
     for &i in items.iter() {
         counts[key(i) as usize + 1] += 1;
@@ -56,5 +61,21 @@ mod tests {
         );
         assert_eq!(items, [1, 4, 2, 5, 6, 0, 3]);
         assert_eq!(offsets, [0, 2, 5, 7]);
+    }
+
+    #[test]
+    fn no_keys_and_no_items_leave_one_empty_offset() {
+        let (mut items, mut scratch, mut cursor) = (Vec::new(), Vec::new(), Vec::new());
+        let mut offsets = vec![9, 9];
+        sort_by_key(
+            &mut items,
+            &mut scratch,
+            &mut cursor,
+            &mut offsets,
+            0,
+            |_| 0,
+        );
+        assert!(items.is_empty());
+        assert_eq!(offsets, [0]);
     }
 }

@@ -36,13 +36,17 @@ use crate::world::{
 };
 use glam::{DMat4, DVec3};
 use hecs::World;
-use radiant_core::Params;
+use radiant_core::{Numbers, Params};
 use serde::Deserialize;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 pub(crate) use yaml::module_spec;
 use yaml::{Mapping, closest, loc, parse_node};
+
+/// The largest film width or height in pixels, in a scene file or as an
+/// override.
+pub const MAX_FILM_SIZE: u32 = 1 << 15;
 
 /// How a frame is rendered: the scene's integrator, film and sampler
 /// settings (command-line options may override them).
@@ -337,11 +341,11 @@ fn parse_film(
     }
     let p: FilmParams = parse_node(file, &marked_yaml::Node::Mapping(rest))?;
     for (value, key, n) in [(p.width, "width", width), (p.height, "height", height)] {
-        if value == 0 || value > 1 << 15 {
+        if !(1..=MAX_FILM_SIZE).contains(&value) {
             return Err(SceneError::new(
                 file,
                 n.and_then(|n| loc(n.span())),
-                format!("film {key} must be between 1 and 32768 pixels, found {value}"),
+                format!("film {key} must be between 1 and {MAX_FILM_SIZE} pixels, found {value}"),
             ));
         }
     }
@@ -456,7 +460,7 @@ struct ShapeDef {
 #[serde(deny_unknown_fields)]
 struct SphereKeys {
     #[serde(default)]
-    center: [f64; 3],
+    center: Numbers<3>,
     #[serde(default = "one")]
     radius: f64,
 }
@@ -533,7 +537,7 @@ fn parse_shape(
                 ));
             }
             transform = transform
-                * DMat4::from_translation(DVec3::from_array(s.center))
+                * DMat4::from_translation(DVec3::from(s.center))
                 * DMat4::from_scale(DVec3::splat(s.radius));
             (Geometry::Sphere, &["center", "radius"])
         }

@@ -12,6 +12,7 @@ use super::SceneError;
 use super::yaml::{Mapping, loc, parse_node, unknown_key};
 use glam::{DMat4, DVec3, DVec4};
 use marked_yaml::Node;
+use radiant_core::Numbers;
 use serde::Deserialize;
 use std::path::Path;
 
@@ -20,7 +21,7 @@ const OPS: &[&str] = &["translate", "rotate", "scale", "matrix", "look_at"];
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Rotate {
-    axis: [f64; 3],
+    axis: Numbers<3>,
     angle: f64,
 }
 
@@ -28,22 +29,22 @@ struct Rotate {
 #[derive(Deserialize, Debug, Clone, Copy)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct LookAt {
-    origin: [f64; 3],
-    target: [f64; 3],
+    origin: Numbers<3>,
+    target: Numbers<3>,
     #[serde(default = "y_up")]
-    up: [f64; 3],
+    up: Numbers<3>,
 }
 
-fn y_up() -> [f64; 3] {
-    [0.0, 1.0, 0.0]
+fn y_up() -> Numbers<3> {
+    Numbers([0.0, 1.0, 0.0])
 }
 
 impl LookAt {
     /// Mitsuba's look-at matrix: columns (left, up, forward, origin).
     pub(crate) fn matrix(&self) -> Option<DMat4> {
-        let origin = DVec3::from_array(self.origin);
-        let dir = (DVec3::from_array(self.target) - origin).try_normalize()?;
-        let left = DVec3::from_array(self.up).cross(dir).try_normalize()?;
+        let origin = DVec3::from(self.origin);
+        let dir = (DVec3::from(self.target) - origin).try_normalize()?;
+        let left = DVec3::from(self.up).cross(dir).try_normalize()?;
         let up = dir.cross(left);
         Some(DMat4::from_cols(
             left.extend(0.0),
@@ -94,10 +95,13 @@ fn parse_op(file: &Path, node: &Node) -> Result<DMat4, SceneError> {
     }
     let (key, value) = entries[0];
     let m = match key.as_str() {
-        "translate" => DMat4::from_translation(DVec3::from_array(parse_node(file, value)?)),
+        "translate" => {
+            let t: Numbers<3> = parse_node(file, value)?;
+            DMat4::from_translation(t.into())
+        }
         "rotate" => {
             let r: Rotate = parse_node(file, value)?;
-            let axis = DVec3::from_array(r.axis).try_normalize().ok_or_else(|| {
+            let axis = DVec3::from(r.axis).try_normalize().ok_or_else(|| {
                 SceneError::new(
                     file,
                     loc(value.span()),
@@ -109,7 +113,7 @@ fn parse_op(file: &Path, node: &Node) -> Result<DMat4, SceneError> {
         "scale" => {
             let s = match value.as_scalar() {
                 Some(_) => DVec3::splat(parse_node::<f64>(file, value)?),
-                None => DVec3::from_array(parse_node(file, value)?),
+                None => parse_node::<Numbers<3>>(file, value)?.into(),
             };
             DMat4::from_scale(s)
         }
@@ -136,9 +140,9 @@ fn parse_op(file: &Path, node: &Node) -> Result<DMat4, SceneError> {
 }
 
 fn parse_matrix(file: &Path, node: &Node) -> Result<DMat4, SceneError> {
-    let rows: Vec<[f64; 4]> = parse_node(file, node)?;
+    let rows: Vec<Numbers<4>> = parse_node(file, node)?;
     let last = DVec4::new(0.0, 0.0, 0.0, 1.0);
-    let rows: Vec<DVec4> = rows.into_iter().map(DVec4::from_array).collect();
+    let rows: Vec<DVec4> = rows.into_iter().map(DVec4::from).collect();
     match rows.len() {
         3 => {}
         4 if rows[3] == last => {}

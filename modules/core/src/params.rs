@@ -190,6 +190,44 @@ impl<'de> Deserialize<'de> for Color {
     }
 }
 
+/// `N` numbers written as a YAML list (a point, a direction, a matrix row):
+/// exactly `N`, where a plain array would let extra elements through
+/// unnoticed (the YAML deserializer does not check for leftovers).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(try_from = "Vec<f64>")]
+pub struct Numbers<const N: usize>(pub [f64; N]);
+
+impl<const N: usize> TryFrom<Vec<f64>> for Numbers<N> {
+    type Error = String;
+
+    fn try_from(values: Vec<f64>) -> Result<Self, String> {
+        let found = values.len();
+        values
+            .try_into()
+            .map(Self)
+            .map_err(|_| format!("expected a list of {N} numbers, found {found}"))
+    }
+}
+
+impl<const N: usize> Default for Numbers<N> {
+    /// All zeros (the origin).
+    fn default() -> Self {
+        Self([0.0; N])
+    }
+}
+
+impl From<Numbers<3>> for glam::DVec3 {
+    fn from(n: Numbers<3>) -> Self {
+        Self::from_array(n.0)
+    }
+}
+
+impl From<Numbers<4>> for glam::DVec4 {
+    fn from(n: Numbers<4>) -> Self {
+        Self::from_array(n.0)
+    }
+}
+
 /// Checks that the documented parameters `docs` are exactly the fields that
 /// `T` accepts (for modules' own tests: `radiant modules` must not lie).
 ///

@@ -2,7 +2,7 @@
 //! a0 + a1 cos(πx/r) + a2 cos(2πx/r) + a3 cos(3πx/r) on [−r, r].
 
 use crate::separable::{Kernel, Separable};
-use crate::validate::positive;
+use crate::validate::radius;
 use radiant_core::{Filter, ModuleInfo, ParamDoc, Registry};
 use serde::Deserialize;
 use std::f32::consts::PI;
@@ -45,7 +45,7 @@ fn two() -> f32 {
 
 const DOCS: &[ParamDoc] = &[ParamDoc {
     name: "radius",
-    ty: "pixels, > 0",
+    ty: "pixels, 0.5–32",
     default: "2",
     doc: "Half-width of the window.",
 }];
@@ -59,7 +59,7 @@ pub(crate) fn register(registry: &mut Registry) {
         },
         |params, _| {
             let p: BlackmanHarrisParams = params.parse()?;
-            let radius = positive(params, "radius", p.radius)?;
+            let radius = radius(params, "radius", p.radius)?;
             Ok(Box::new(Separable(BlackmanHarrisKernel { radius })) as Box<dyn Filter>)
         },
     );

@@ -1,7 +1,7 @@
 //! The `box` filter: every sample within the radius counts equally.
 
 use crate::separable::{Kernel, Separable};
-use crate::validate::{half, positive};
+use crate::validate::{half, radius};
 use radiant_core::{Filter, ModuleInfo, ParamDoc, Registry};
 use serde::Deserialize;
 
@@ -34,7 +34,7 @@ struct BoxParams {
 
 const DOCS: &[ParamDoc] = &[ParamDoc {
     name: "radius",
-    ty: "pixels, > 0",
+    ty: "pixels, 0.5–32",
     default: "0.5",
     doc: "Half-width of the box.",
 }];
@@ -48,7 +48,7 @@ pub(crate) fn register(registry: &mut Registry) {
         },
         |params, _| {
             let p: BoxParams = params.parse()?;
-            let radius = positive(params, "radius", p.radius)?;
+            let radius = radius(params, "radius", p.radius)?;
             Ok(Box::new(Separable(BoxKernel { radius })) as Box<dyn Filter>)
         },
     );

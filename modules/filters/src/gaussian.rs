@@ -2,9 +2,13 @@
 //! max(0, exp(−x²/2σ²) − exp(−r²/2σ²)) per axis.
 
 use crate::separable::{Kernel, Separable};
-use crate::validate::{half, positive};
-use radiant_core::{Filter, ModuleInfo, ParamDoc, Registry};
+use crate::validate::{half, positive, radius};
+use radiant_core::{Filter, ModuleInfo, ParamDoc, ParamError, Registry};
 use serde::Deserialize;
+
+/// The widest cut-off in standard deviations: the film tabulates a filter at
+/// 64 points over its radius, so a narrower Gaussian would fall between them.
+const MAX_RADII: f32 = 16.0;
 
 /// The truncated Gaussian kernel.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,7 +60,7 @@ const DOCS: &[ParamDoc] = &[
     },
     ParamDoc {
         name: "radius",
-        ty: "pixels, > 0",
+        ty: "pixels, 0.5–32, ≤ 16 × stddev",
         default: "4 × stddev",
         doc: "Where the Gaussian is cut off (it is shifted down to reach 0 there).",
     },
@@ -72,7 +76,21 @@ pub(crate) fn register(registry: &mut Registry) {
         |params, _| {
             let p: GaussianParams = params.parse()?;
             let stddev = positive(params, "stddev", p.stddev)?;
-            let radius = positive(params, "radius", p.radius.unwrap_or(4.0 * stddev))?;
+            let key = if p.radius.is_some() {
+                "radius"
+            } else {
+                "stddev"
+            };
+            let radius = radius(params, key, p.radius.unwrap_or(4.0 * stddev))?;
+            if radius > MAX_RADII * stddev {
+                return Err(ParamError {
+                    message: format!(
+                        "`radius` ({radius}) must be at most {MAX_RADII} × `stddev` ({stddev}): \
+                         a narrower Gaussian falls between the filter table's samples"
+                    ),
+                    location: params.location_of("radius"),
+                });
+            }
             Ok(Box::new(Separable(GaussianKernel::new(stddev, radius))) as Box<dyn Filter>)
         },
     );

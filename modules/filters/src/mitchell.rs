@@ -2,7 +2,7 @@
 //! and C, stretched from its natural support [−2, 2] to [−r, r].
 
 use crate::separable::{Kernel, Separable};
-use crate::validate::{finite, positive};
+use crate::validate::{radius, unit};
 use radiant_core::{Filter, ModuleInfo, ParamDoc, Registry};
 use serde::Deserialize;
 
@@ -82,19 +82,19 @@ fn two() -> f32 {
 const DOCS: &[ParamDoc] = &[
     ParamDoc {
         name: "B",
-        ty: "number",
+        ty: "0–1",
         default: "1/3",
         doc: "Blur parameter B of the Mitchell–Netravali family (B = 1, C = 0 is the cubic B-spline).",
     },
     ParamDoc {
         name: "C",
-        ty: "number",
+        ty: "0–1",
         default: "1/3",
         doc: "Ringing parameter C (B = 0, C = 0.5 is Catmull–Rom).",
     },
     ParamDoc {
         name: "radius",
-        ty: "pixels, > 0",
+        ty: "pixels, 0.5–32",
         default: "2",
         doc: "Support half-width; the cubic's natural support [−2, 2] is scaled to it.",
     },
@@ -109,9 +109,9 @@ pub(crate) fn register(registry: &mut Registry) {
         },
         |params, _| {
             let p: MitchellParams = params.parse()?;
-            let b = finite(params, "B", p.B)?;
-            let c = finite(params, "C", p.C)?;
-            let radius = positive(params, "radius", p.radius)?;
+            let b = unit(params, "B", p.B)?;
+            let c = unit(params, "C", p.C)?;
+            let radius = radius(params, "radius", p.radius)?;
             Ok(Box::new(Separable(MitchellKernel::new(b, c, radius))) as Box<dyn Filter>)
         },
     );

@@ -1,7 +1,7 @@
 //! The `tent` filter: 1 − |x|/r per axis (the seeds' SmallPT-style tent).
 
 use crate::separable::{Kernel, Separable};
-use crate::validate::positive;
+use crate::validate::radius;
 use radiant_core::{Filter, ModuleInfo, ParamDoc, Registry};
 use serde::Deserialize;
 
@@ -38,7 +38,7 @@ fn one() -> f32 {
 
 const DOCS: &[ParamDoc] = &[ParamDoc {
     name: "radius",
-    ty: "pixels, > 0",
+    ty: "pixels, 0.5–32",
     default: "1",
     doc: "Where the tent reaches zero.",
 }];
@@ -52,7 +52,7 @@ pub(crate) fn register(registry: &mut Registry) {
         },
         |params, _| {
             let p: TentParams = params.parse()?;
-            let radius = positive(params, "radius", p.radius)?;
+            let radius = radius(params, "radius", p.radius)?;
             Ok(Box::new(Separable(TentKernel { radius })) as Box<dyn Filter>)
         },
     );

@@ -178,10 +178,31 @@ fn registered_filters_build_with_defaults() {
 #[test]
 fn bad_parameters_are_rejected_at_their_key() {
     for (ty, yaml, line, needle) in [
-        ("tent", "radius: 0", 1, "positive"),
-        ("blackman_harris", "\nradius: -2", 2, "positive"),
-        ("mitchell", "B: 1e40", 1, "finite"),
-        ("mitchell", "radius: 1e39", 1, "positive"),
+        ("tent", "radius: 0", 1, "from 0.5 to 32 pixels"),
+        (
+            "blackman_harris",
+            "\nradius: -2",
+            2,
+            "from 0.5 to 32 pixels",
+        ),
+        ("box", "radius: 1e12", 1, "from 0.5 to 32 pixels"),
+        (
+            "box",
+            "radius: 1e-30",
+            1,
+            "samples between pixel centres are lost",
+        ),
+        ("gaussian", "stddev: 1e-30", 1, "from 0.5 to 32 pixels"),
+        (
+            "gaussian",
+            "stddev: 0.01\nradius: 10",
+            2,
+            "at most 16 × `stddev`",
+        ),
+        ("gaussian", "stddev: 0", 1, "positive"),
+        ("mitchell", "B: 1e40", 1, "from 0 to 1"),
+        ("mitchell", "\nC: -6", 2, "from 0 to 1"),
+        ("mitchell", "radius: 1e39", 1, "from 0.5 to 32 pixels"),
         ("mitchell", "radius: wide", 1, "number"),
         ("lanczos", "lobes: 0", 1, "1 to 16"),
         ("lanczos", "lobes: 2.5", 1, "integer"),

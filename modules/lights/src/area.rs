@@ -8,6 +8,7 @@
 //! ([`crate::rectangle`]), and otherwise uniformly by area. `eval_hits`
 //! returns the density of the same strategy for the part that was hit.
 
+use crate::params::check_colour;
 use crate::rectangle::Rectangle;
 use crate::sphere::Cone;
 use radiant_core::glam::{Vec2, Vec3};
@@ -274,6 +275,7 @@ pub(crate) fn register(registry: &mut Registry) {
         },
         |params: &Params, ctx| {
             let p: AreaParams = params.parse()?;
+            check_colour(params, "radiance", p.radiance.0)?;
             let shape = ctx.emitter_shape.ok_or_else(|| {
                 ParamError::new(
                     "an `area` light must be attached to a shape: write it as the shape's `emitter:`",

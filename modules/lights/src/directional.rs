@@ -6,15 +6,15 @@ use crate::delta::sample_delta;
 use crate::params::{axis, check_colour};
 use radiant_core::glam::{DVec3, Vec2, Vec3};
 use radiant_core::{
-    BoundingSphere, BuildContext, Color, Effects, Light, LightSample, ParamDoc, ParamError, Params,
-    Registry, Rgb, luminance,
+    BoundingSphere, BuildContext, Color, Effects, Light, LightSample, Numbers, ParamDoc,
+    ParamError, Params, Registry, Rgb, luminance,
 };
 use serde::Deserialize;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct DirectionalParams {
-    direction: Option<[f64; 3]>,
+    direction: Option<Numbers<3>>,
     irradiance: Color,
 }
 

@@ -30,24 +30,7 @@ pub(crate) fn load_map(path: &Path) -> Result<(Vec<Rgb>, UVec2), String> {
 }
 
 fn read_exr(path: &Path) -> Result<(Vec<Rgb>, UVec2), String> {
-    use exr::prelude::read_first_rgba_layer_from_file;
-    let image = read_first_rgba_layer_from_file(
-        path,
-        |resolution, _| {
-            let (w, h) = (resolution.width(), resolution.height());
-            (vec![Rgb::ZERO; w * h], w)
-        },
-        |(pixels, w): &mut (Vec<Rgb>, usize), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            pixels[pos.y() * *w + pos.x()] = Rgb::new(r, g, b);
-        },
-    )
-    .map_err(|e| e.to_string())?;
-    let size = image.layer_data.size;
-    let (pixels, _) = image.layer_data.channel_data.pixels;
-    Ok((
-        pixels,
-        UVec2::new(size.width() as u32, size.height() as u32),
-    ))
+    radiant_core::exr_file::read_exr_rgb(path).map_err(|e| e.to_string())
 }
 
 fn read_hdr(path: &Path) -> Result<(Vec<Rgb>, UVec2), String> {

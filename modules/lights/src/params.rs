@@ -3,7 +3,7 @@
 //! to world space) moves its positions and turns its directions.
 
 use radiant_core::glam::{DVec3, Vec3};
-use radiant_core::{BuildContext, ParamError, Params, Rgb};
+use radiant_core::{BuildContext, Numbers, ParamError, Params, Rgb};
 
 /// Rejects a colour parameter `key` that is negative or not finite.
 pub(crate) fn check_colour(params: &Params, key: &str, c: Rgb) -> Result<(), ParamError> {
@@ -29,8 +29,8 @@ pub(crate) fn axis(
     params: &Params,
     ctx: &BuildContext<'_>,
     position: DVec3,
-    direction: Option<[f64; 3]>,
-    target: Option<[f64; 3]>,
+    direction: Option<Numbers<3>>,
+    target: Option<Numbers<3>>,
 ) -> Result<Vec3, ParamError> {
     let (key, d) = match (direction, target) {
         (Some(_), Some(_)) => {
@@ -39,8 +39,8 @@ pub(crate) fn axis(
                 location: params.location_of("target"),
             });
         }
-        (Some(d), None) => ("direction", DVec3::from_array(d)),
-        (None, Some(t)) => ("target", DVec3::from_array(t) - position),
+        (Some(d), None) => ("direction", DVec3::from(d)),
+        (None, Some(t)) => ("target", DVec3::from(t) - position),
         (None, None) => ("direction", DVec3::Z),
     };
     let d = ctx.to_world.transform_vector3(d);

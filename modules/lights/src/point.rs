@@ -4,15 +4,15 @@ use crate::delta::sample_delta;
 use crate::params::{check_colour, place};
 use radiant_core::glam::{DVec3, Vec2, Vec3};
 use radiant_core::{
-    BuildContext, Color, Effects, Light, LightSample, ParamDoc, ParamError, Params, Registry, Rgb,
-    luminance,
+    BuildContext, Color, Effects, Light, LightSample, Numbers, ParamDoc, ParamError, Params,
+    Registry, Rgb, luminance,
 };
 use serde::Deserialize;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct PointParams {
-    position: [f64; 3],
+    position: Numbers<3>,
     intensity: Color,
 }
 
@@ -77,7 +77,7 @@ impl Light for PointLight {
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<PointLight, ParamError> {
     let p: PointParams = params.parse()?;
     check_colour(params, "intensity", p.intensity.0)?;
-    let position = place(ctx, DVec3::from_array(p.position));
+    let position = place(ctx, DVec3::from(p.position));
     Ok(PointLight::new(position, p.intensity.0))
 }
 

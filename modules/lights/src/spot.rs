@@ -6,8 +6,8 @@ use crate::delta::sample_delta;
 use crate::params::{axis, check_colour, place};
 use radiant_core::glam::{DVec3, Vec2, Vec3};
 use radiant_core::{
-    BuildContext, Color, Effects, Light, LightSample, ParamDoc, ParamError, Params, Registry, Rgb,
-    luminance,
+    BuildContext, Color, Effects, Light, LightSample, Numbers, ParamDoc, ParamError, Params,
+    Registry, Rgb, luminance,
 };
 use serde::Deserialize;
 
@@ -15,9 +15,9 @@ use serde::Deserialize;
 #[serde(deny_unknown_fields)]
 struct SpotParams {
     #[serde(default)]
-    position: [f64; 3],
-    direction: Option<[f64; 3]>,
-    target: Option<[f64; 3]>,
+    position: Numbers<3>,
+    direction: Option<Numbers<3>>,
+    target: Option<Numbers<3>>,
     intensity: Color,
     #[serde(default = "default_cutoff")]
     cutoff_angle: f32,
@@ -168,7 +168,7 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<SpotLight, Param
             location: params.location_of("beam_width"),
         });
     }
-    let position = DVec3::from_array(p.position);
+    let position = DVec3::from(p.position);
     let axis = axis(params, ctx, position, p.direction, p.target)?;
     Ok(SpotLight::new(
         place(ctx, position),

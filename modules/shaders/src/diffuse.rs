@@ -1,6 +1,6 @@
 //! The `diffuse` shader: an ideal one-sided Lambertian reflector.
 
-use crate::inputs::half;
+use crate::inputs::{fraction, half};
 use crate::lobes::reflection_sample;
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
@@ -91,7 +91,7 @@ impl Shader for Diffuse {
 
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Diffuse, ParamError> {
     let p: DiffuseParams = params.parse()?;
-    let reflectance = ctx.texture(&p.reflectance)?;
+    let reflectance = fraction(ctx, &p.reflectance, "reflectance")?;
     let effects = ctx.textures.effects(reflectance);
     Ok(Diffuse::new(reflectance, effects))
 }

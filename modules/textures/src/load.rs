@@ -63,20 +63,13 @@ fn read_error(path: &Path, e: impl std::fmt::Display) -> LoadError {
 }
 
 fn load_exr(path: &Path) -> Result<Texels, LoadError> {
-    use exr::prelude::read_first_rgba_layer_from_file;
-    let image = read_first_rgba_layer_from_file(
-        path,
-        |resolution, _| Texels {
-            width: resolution.width() as u32,
-            height: resolution.height() as u32,
-            data: vec![Rgb::ZERO; resolution.width() * resolution.height()],
-        },
-        |t: &mut Texels, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            t.data[pos.y() * t.width as usize + pos.x()] = Rgb::new(r, g, b);
-        },
-    )
-    .map_err(|e| read_error(path, e))?;
-    Ok(image.layer_data.channel_data.pixels)
+    let (data, size) =
+        radiant_core::exr_file::read_exr_rgb(path).map_err(|e| read_error(path, e))?;
+    Ok(Texels {
+        width: size.x,
+        height: size.y,
+        data,
+    })
 }
 
 fn load_image(path: &Path, raw: bool) -> Result<Texels, LoadError> {
