@@ -304,7 +304,7 @@ fn bad_light_parameters_are_located_and_explained() {
     fails_at(
         &light("{type: point, intensity: 1, position: [0, 0, 0], transform: {rotate: 5}}"),
         3,
-        &[],
+        &["expected a rotation `{axis: [x, y, z], angle: degrees}`"],
     );
 }
 
@@ -406,4 +406,20 @@ fn overrides_outside_the_allowed_ranges_are_errors() {
         };
         assert!(err.to_string().contains(needle), "{err}");
     }
+}
+
+#[test]
+fn text_the_yaml_parser_would_drop_is_an_error() {
+    fails_at(
+        &format!("{CAMERA}film: {{width: 8}}\0\nshapes: [{{type: cube}}]\n"),
+        2,
+        &["NUL character"],
+    );
+    fails_at(
+        &format!("{CAMERA}---\nshapes: [{{type: cube}}]\n"),
+        2,
+        &["one YAML document", "second one starts here"],
+    );
+    // One document with explicit start and end markers is fine.
+    load(&format!("# a scene\n---\n{CAMERA}...\n# the end\n")).expect("a single document");
 }

@@ -102,6 +102,7 @@ fn a_bad_scene_fails_with_its_location_and_writes_nothing() {
 #[test]
 fn bad_arguments_are_refused_before_rendering() {
     let (_dir, out) = temp("x.bmp");
+    let png = out.with_extension("png");
     let o = radiant(&[
         "render",
         "scenes/cornell-box.yaml",
@@ -125,11 +126,13 @@ fn bad_arguments_are_refused_before_rendering() {
         "render",
         "scenes/cornell-box.yaml",
         "-o",
-        "x.png",
+        png.to_str().unwrap(),
         "--spp",
         "0",
     ]);
     assert!(!o.status.success());
+    assert!(stderr(&o).contains("--spp"), "{}", stderr(&o));
+    assert!(!png.exists());
     let o = radiant(&["render", "scenes/missing.yaml", "-o", "x.png"]);
     assert!(!o.status.success());
     assert!(
@@ -192,15 +195,17 @@ fn modules_lists_every_type_with_parameters() {
 #[test]
 fn compare_prints_metrics_and_rejects_size_mismatches() {
     let (dir, a) = temp("a.exr");
-    let b = dir.path().join("b.exr");
-    for (path, w) in [(&a, "32"), (&b, "16")] {
+    let (b, wide) = (dir.path().join("b.exr"), dir.path().join("wide.exr"));
+    for (path, w, seed) in [(&a, "16", "1"), (&b, "16", "2"), (&wide, "32", "1")] {
         let o = radiant(&[
             "render",
             "scenes/cornell-box.yaml",
             "-o",
             path.to_str().unwrap(),
             "--spp",
-            "1",
+            "2",
+            "--seed",
+            seed,
             "--width",
             w,
             "--height",
@@ -208,14 +213,21 @@ fn compare_prints_metrics_and_rejects_size_mismatches() {
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
     }
-    let o = radiant(&["compare", a.to_str().unwrap(), a.to_str().unwrap()]);
-    assert!(o.status.success());
-    let out = stdout(&o);
-    assert!(
-        out.contains("rmse 0.000000") && out.contains("mean_ratio 1.000000"),
-        "{out}"
-    );
+    // Two seeds: the printed metrics are the library's, and not zero.
     let o = radiant(&["compare", a.to_str().unwrap(), b.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    let read = |p: &Path| radiant::film::output::read_exr(p).unwrap();
+    let c = radiant::compare::compare(&read(&a), &read(&b)).unwrap();
+    assert!(c.rmse > 1e-3, "different seeds give different images");
+    for line in [
+        format!("rmse {:.6}", c.rmse),
+        format!("relative_mse {:.6}", c.relative_mse),
+        format!("mean_ratio {:.6}", c.mean_ratio),
+    ] {
+        assert!(out.contains(&line), "`{line}` missing from:\n{out}");
+    }
+    let o = radiant(&["compare", a.to_str().unwrap(), wide.to_str().unwrap()]);
     assert!(!o.status.success());
     assert!(stderr(&o).contains("differ in size"), "{}", stderr(&o));
 }

@@ -199,7 +199,10 @@ impl Chi2 {
             dof += 1;
         }
         if dof < 2 {
-            return Ok(1.0);
+            return Err(format!(
+                "only {dof} cell(s) with enough expected samples: the test cannot judge \
+                 the distribution (use more samples or fewer cells)"
+            ));
         }
         let p = 1.0
             - ChiSquared::new((dof - 1) as f64)

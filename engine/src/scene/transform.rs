@@ -19,7 +19,10 @@ use std::path::Path;
 const OPS: &[&str] = &["translate", "rotate", "scale", "matrix", "look_at"];
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a rotation `{axis: [x, y, z], angle: degrees}`"
+)]
 struct Rotate {
     axis: Numbers<3>,
     angle: f64,

@@ -15,9 +15,61 @@ pub(crate) fn loc(span: &Span) -> Option<Location> {
     Location::of(span)
 }
 
+/// The location of byte `at` of `text` (1-based line and column, in
+/// characters).
+fn location_of_byte(text: &str, at: usize) -> Location {
+    let before = &text[..at];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    Location { line, column }
+}
+
+/// Rejects what the YAML parser would silently drop: a NUL character (the
+/// parser stops there) and a second document after `---` or `...` (only the
+/// first would be read).
+fn check_single_document(file: &Path, text: &str) -> Result<(), SceneError> {
+    if let Some(at) = text.find('\0') {
+        return Err(SceneError::new(
+            file,
+            Some(location_of_byte(text, at)),
+            "the scene file contains a NUL character; expected plain UTF-8 text",
+        ));
+    }
+    let is_marker = |l: &str| {
+        ["---", "..."].iter().any(|m| {
+            l.strip_prefix(m)
+                .is_some_and(|r| r.is_empty() || r.starts_with([' ', '\t']))
+        })
+    };
+    let is_content = |l: &str| {
+        let t = l.trim();
+        !t.is_empty() && !t.starts_with('#') && !is_marker(l)
+    };
+    let lines: Vec<&str> = text.lines().collect();
+    let Some(first) = lines.iter().position(|l| is_content(l)) else {
+        return Ok(());
+    };
+    if let Some(marker) = lines[first..].iter().position(|l| is_marker(l)) {
+        let marker = first + marker;
+        if lines[marker + 1..].iter().any(|l| is_content(l)) {
+            return Err(SceneError::new(
+                file,
+                Some(Location {
+                    line: marker + 1,
+                    column: 1,
+                }),
+                "a scene file holds one YAML document; a second one starts here \
+                 (remove the `---`/`...` marker or split the file)",
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Parses a YAML document into a tree of marked nodes.
 pub(crate) fn parse_document(file: &Path, text: &str) -> Result<Node, SceneError> {
     use marked_yaml::LoadError;
+    check_single_document(file, text)?;
     let options = marked_yaml::LoaderOptions::default()
         .error_on_duplicate_keys(true)
         .toplevel_mapping();
