@@ -12,7 +12,7 @@ use radiant_filters::{
     BlackmanHarrisKernel, BoxKernel, GaussianKernel, LanczosKernel, MitchellKernel, Separable,
     TentKernel,
 };
-use radiant_tests::chi2::{Chi2, Rng};
+use radiant_tests::chi2::{Chi2, Rng, SIGNIFICANCE};
 
 #[test]
 fn thin_lens_aperture_samples_match_the_uniform_disk_density() {
@@ -105,7 +105,7 @@ fn filter_importance_sampling_matches_the_normalised_absolute_filter() {
         phi_cells: 16,
         refine: 16,
         samples: 400_000,
-        significance: 1e-3,
+        significance: SIGNIFICANCE,
     };
     for (name, f) in filters() {
         let sampler = FilterSampler::new(&*f, FilterSampler::DEFAULT_RESOLUTION);
