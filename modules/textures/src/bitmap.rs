@@ -12,7 +12,7 @@
 //! it, and the render converges to the correctly filtered image (mipmaps
 //! would lower that noise at the price of a blur bias).
 
-use crate::load::{Texels, load};
+use crate::load::{LoadError, Texels, load};
 use crate::wrap::WrapMode;
 use radiant_core::glam::Vec2;
 use radiant_core::{
@@ -163,7 +163,10 @@ pub(crate) fn register(registry: &mut Registry) {
             let p: ImageParams = params.parse()?;
             let path = ctx.scene_dir.join(&p.filename);
             let texels = load(&path, p.raw).map_err(|e| ParamError {
-                message: format!("{e}; expected a readable PNG, JPEG, EXR or HDR file"),
+                message: match e {
+                    LoadError::NonFinite { .. } => e.to_string(),
+                    _ => format!("{e}; expected a readable PNG, JPEG, EXR or HDR file"),
+                },
                 location: params.location_of("filename"),
             })?;
             Ok(Box::new(ImageTexture::new(texels, p.filter, p.wrap)) as Box<dyn Texture>)

@@ -25,6 +25,21 @@ pub enum LoadError {
     /// The file holds no pixels.
     #[error("image `{0}` has no pixels")]
     Empty(PathBuf),
+    /// Some texels are NaN or infinite (float formats only).
+    #[error(
+        "image `{path}` has {count} NaN or infinite texels (the first at column {x}, row {y} \
+         from the top); a texture must hold finite values"
+    )]
+    NonFinite {
+        /// The file.
+        path: PathBuf,
+        /// How many texels are not finite.
+        count: usize,
+        /// Column of the first one.
+        x: u32,
+        /// Row of the first one, from the top.
+        y: u32,
+    },
 }
 
 /// Linear RGB texels, row-major, top row first.
@@ -51,6 +66,14 @@ pub fn load(path: &Path, raw: bool) -> Result<Texels, LoadError> {
     };
     if texels.width == 0 || texels.height == 0 {
         return Err(LoadError::Empty(path.to_path_buf()));
+    }
+    if let Some(first) = texels.data.iter().position(|t| !t.is_finite()) {
+        return Err(LoadError::NonFinite {
+            path: path.to_path_buf(),
+            count: texels.data.iter().filter(|t| !t.is_finite()).count(),
+            x: first as u32 % texels.width,
+            y: first as u32 / texels.width,
+        });
     }
     Ok(texels)
 }

@@ -384,3 +384,29 @@ fn uv_transform_scales_rotates_and_offsets() {
         assert_eq!(e.location.map(|l| l.line), Some(line), "{yaml:?}: {e:?}");
     }
 }
+
+#[test]
+fn images_with_non_finite_texels_are_errors_at_the_filename() {
+    use exr::prelude::*;
+    let dir = tempfile::tempdir().unwrap();
+    // A 3×2 image with NaN at column 2 of the top row and +∞ below it.
+    write_rgb_file(dir.path().join("bad.exr"), 3, 2, |x, y| match (x, y) {
+        (2, 0) => (f32::NAN, 0.5, 0.5),
+        (2, 1) => (0.5, f32::INFINITY, 0.5),
+        _ => (0.5, 0.5, 0.5),
+    })
+    .unwrap();
+    let mut s = Scene::new(dir.path().to_path_buf());
+    let Err(BuildError::Params(e)) = s.add("x", "image", "filename: bad.exr") else {
+        panic!("an image with NaN texels should be rejected");
+    };
+    assert!(
+        e.message.contains("2 NaN or infinite texels")
+            && e.message.contains("column 2, row 0")
+            && e.message.contains("bad.exr")
+            && !e.message.contains("readable"),
+        "{}",
+        e.message
+    );
+    assert_eq!(e.location.map(|l| l.line), Some(1), "{}", e.message);
+}
