@@ -26,10 +26,12 @@ pub mod accel;
 pub mod accuracy;
 pub mod backend;
 pub mod compare;
+pub mod error;
 pub mod extract;
 pub mod film;
 pub mod integrators;
 pub mod scene;
+pub mod settings;
 pub mod world;
 
 pub use radiant_core as core;

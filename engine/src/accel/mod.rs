@@ -1,29 +1,44 @@
-//! Acceleration: the BVH over all primitives and robust ray queries.
+//! Acceleration: two levels of bounding volume hierarchies and robust
+//! ray queries.
 //!
-//! obvhs builds a binary BVH over the primitives' boxes, which `wide`
-//! collapses into the 8-wide BVH that rays traverse. Primitives (triangles
-//! and analytic spheres) are numbered in its leaf order, so a leaf's
-//! primitives are contiguous and a hit's primitive index addresses the
-//! shading arrays directly. A leaf's triangles are stored as packets of
-//! four ([`triangle::Tri4`]) and tested together with SIMD.
+//! The bottom level ([`Blas`]) holds primitives in their own space: all
+//! static shapes merged in render space, or one shape in object space — a
+//! mesh placed many times, a shape that moves, a mesh that deforms. The
+//! top level is a hierarchy over [`Instance`]s, each a bottom level and
+//! its placement in render space (none, a fixed transform, or a motion
+//! during the shutter). A scene of static shapes alone is one instance
+//! without placement, queried directly without a top level, as if there
+//! were one hierarchy. Hits name the instance and the primitive; primitives
+//! are numbered across all bottom levels (each level's numbers start at
+//! its base), so a hit's primitive addresses the shading arrays directly.
 //!
-//! Triangles use the watertight test of Woop et al. 2013. Spawned rays
-//! start at origins offset by a conservative bound on the hit point's
-//! floating-point error ([`offset`]), which keeps self-intersection away at
-//! every scene scale without a fixed epsilon.
+//! Both levels are 8-wide BVHs collapsed from obvhs' binary ones
+//! ([`hierarchy`]). Triangles use the watertight test of Woop et al. 2013.
+//! Spawned rays start at origins offset by a conservative bound on the hit
+//! point's floating-point error ([`offset`]), which keeps self-intersection
+//! away at every scene scale without a fixed epsilon; instance transforms
+//! carry those bounds across ([`instance`]).
 
+mod blas;
+pub mod hierarchy;
+pub mod instance;
 pub mod offset;
 pub mod sphere;
 pub mod triangle;
 mod wide;
 
+pub use crate::settings::BuildQuality;
+pub use blas::Blas;
+pub use hierarchy::{Update, UpdatePolicy};
+pub use instance::{Motion, Placement};
+
 use glam::{Vec3, Vec3A};
-use obvhs::BvhBuildParams;
+use hierarchy::Hierarchy;
 use obvhs::aabb::Aabb;
+use std::marker::PhantomData;
 use std::ops::Range;
-use std::time::Duration;
-use triangle::{RayPrep, Tri4};
-use wide::{Avx2, Baseline, Isa, LeafVisitor, RayBoxes, WideBvh};
+use std::time::{Duration, Instant};
+use wide::{Avx2, Baseline, Isa, LeafCost, LeafVisitor, RayBoxes};
 
 /// A primitive as the intersector sees it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,34 +49,15 @@ pub enum Primitive {
     Sphere(Vec3, f32),
 }
 
-impl Primitive {
-    /// The bounding box, or `None` where a coordinate is not finite (such
-    /// a primitive is never hit).
-    fn aabb(&self) -> Option<Aabb> {
-        let aabb = match *self {
-            Primitive::Triangle([a, b, c]) => {
-                let a = Vec3A::from(a);
-                let b = Vec3A::from(b);
-                let c = Vec3A::from(c);
-                Aabb::new(a.min(b).min(c), a.max(b).max(c))
-            }
-            Primitive::Sphere(c, r) => {
-                let c = Vec3A::from(c);
-                let r = Vec3A::splat(r.abs());
-                Aabb::new(c - r, c + r)
-            }
-        };
-        (aabb.min.is_finite() && aabb.max.is_finite()).then_some(aabb)
-    }
-}
-
 /// The closest hit of a ray.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Hit {
     /// Distance along the ray (in units of the direction's length).
     pub t: f32,
-    /// Index of the primitive (in BVH order).
+    /// Index of the primitive (numbered across bottom levels, leaf order).
     pub prim: u32,
+    /// Index of the instance that was hit.
+    pub inst: u32,
     /// Barycentric coordinates of vertices 1 and 2 (triangles only).
     pub b1: f32,
     /// See `b1`.
@@ -74,225 +70,316 @@ impl Hit {
     pub const MISS: Hit = Hit {
         t: f32::INFINITY,
         prim: u32::MAX,
+        inst: u32::MAX,
         b1: 0.0,
         b2: 0.0,
     };
 }
 
-/// BVH quality preset.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum BuildQuality {
-    /// Fast build, slower traversal.
-    Fast,
-    /// The trade-off for very large scenes.
-    Medium,
-    /// Slow build (about twice Medium's), best traversal.
-    High,
+/// Where an instance's bottom level lies in render space.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Place {
+    /// Already in render space (the merged static shapes).
+    Identity,
+    /// Through a fixed transform.
+    Fixed(Placement),
+    /// Through a transform that moves while the shutter is open.
+    Moving(Motion),
 }
 
-impl BuildQuality {
-    /// Primitives up to which scenes get [`BuildQuality::High`] by default.
-    pub const HIGH_UP_TO: usize = 1 << 20;
-
-    /// The default for a scene of `primitives`: `High` up to
-    /// [`Self::HIGH_UP_TO`] (0.27 s instead of 0.14 s for 169k triangles on
-    /// one core; the Cornell box renders 4.5 % faster), `Medium` beyond,
-    /// where the build's time starts to count.
-    pub fn default_for(primitives: usize) -> Self {
-        if primitives <= Self::HIGH_UP_TO {
-            Self::High
-        } else {
-            Self::Medium
+impl Place {
+    /// The placement at shutter time `tau`, `None` for the identity (or
+    /// where a motion passes through a singular transform).
+    #[inline]
+    pub fn at(&self, tau: f32) -> Option<Placement> {
+        match self {
+            Place::Identity => None,
+            Place::Fixed(p) => Some(*p),
+            Place::Moving(m) => m.at(tau),
         }
     }
-
-    /// obvhs' parameters for the binary BVH.
-    fn params(self) -> BvhBuildParams {
-        let mut params = match self {
-            BuildQuality::Fast => BvhBuildParams::fast_build(),
-            BuildQuality::Medium => BvhBuildParams::medium_build(),
-            BuildQuality::High => BvhBuildParams::slow_build(),
-        };
-        // One primitive per leaf: the wide BVH's collapse picks the leaves.
-        params.max_prims_per_leaf = 1;
-        params
-    }
 }
 
-/// What a leaf holds: triangles four at a time, or one sphere.
-#[derive(Debug, Clone, Copy)]
-enum Packet {
-    /// Up to four triangles, primitives `first`, `first + 1`, ….
-    Triangles { tris: Tri4, first: u32 },
-    /// A sphere, primitive `prim`.
-    Sphere {
-        centre: Vec3,
-        radius: f32,
-        prim: u32,
-    },
+/// A bottom level placed in render space.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Instance {
+    /// Index of the bottom level.
+    pub blas: u32,
+    /// Its placement.
+    pub place: Place,
 }
 
-/// A built BVH with its primitives in leaf order.
+/// The scene's acceleration structure: bottom levels, their instances and
+/// the top level over them.
 pub struct Accel {
-    bvh: WideBvh,
-    packets: Vec<Packet>,
-    prims: Vec<Primitive>,
+    blases: Vec<Blas>,
+    /// Per bottom level, the number of its first primitive.
+    bases: Vec<u32>,
+    instances: Vec<Instance>,
+    tlas: Hierarchy,
+    /// Instance indices in the top level's leaf order.
+    tlas_items: Vec<u32>,
+    /// Whether queries go straight to instance 0 (one instance, no
+    /// placement).
+    direct: bool,
+    quality: BuildQuality,
     /// Whether queries run the AVX2 traversal (the CPU has AVX2; only
     /// read on x86_64).
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     avx2: bool,
-    /// Time the build took.
+    /// Time the last build or update of the top level took.
     pub build_time: Duration,
 }
 
 impl Accel {
-    /// Builds the BVH over `prims`; returns it and, for each BVH-order
-    /// index, the index of the primitive in `prims`.
-    pub fn build(prims: &[Primitive], quality: BuildQuality) -> (Self, Vec<u32>) {
-        let start = std::time::Instant::now();
-        let boxes: Vec<Option<Aabb>> = prims.iter().map(Primitive::aabb).collect();
-        // Primitives with non-finite coordinates get a point box inside the
-        // scene, so that they cannot spoil the boxes above them.
-        let somewhere = boxes.iter().flatten().next().map_or(Vec3A::ZERO, |b| b.min);
-        let point = Aabb::new(somewhere, somewhere);
-        let boxes: Vec<Aabb> = boxes.into_iter().map(|b| b.unwrap_or(point)).collect();
-
-        let mut order = Vec::with_capacity(prims.len());
-        let mut packets = Vec::new();
-        let bvh = if prims.is_empty() {
-            WideBvh::default()
-        } else {
-            let mut core_time = Duration::default();
-            let bvh2 = obvhs::bvh2::builder::build_bvh2(&boxes, quality.params(), &mut core_time);
-            WideBvh::build(&bvh2, |leaf| {
-                let start = packets.len() as u32;
-                // Triangles first, so that they pack into runs of four.
-                let (tris, spheres): (Vec<u32>, Vec<u32>) = leaf
-                    .iter()
-                    .partition(|&&i| matches!(prims[i as usize], Primitive::Triangle(_)));
-                for chunk in tris.chunks(4) {
-                    let first = order.len() as u32;
-                    let vertices: Vec<[Vec3; 3]> = chunk
-                        .iter()
-                        .filter_map(|&i| match prims[i as usize] {
-                            Primitive::Triangle(v) => Some(v),
-                            Primitive::Sphere(..) => None,
-                        })
-                        .collect();
-                    order.extend_from_slice(chunk);
-                    packets.push(Packet::Triangles {
-                        tris: Tri4::new(&vertices),
-                        first,
-                    });
-                }
-                for &i in &spheres {
-                    if let Primitive::Sphere(centre, radius) = prims[i as usize] {
-                        packets.push(Packet::Sphere {
-                            centre,
-                            radius,
-                            prim: order.len() as u32,
-                        });
-                        order.push(i);
-                    }
-                }
-                start..packets.len() as u32
-            })
-        };
-        debug_assert_eq!(order.len(), prims.len());
-        let ordered = order.iter().map(|&i| prims[i as usize]).collect();
-        let accel = Self {
-            bvh,
-            packets,
-            prims: ordered,
+    /// The accelerator over `blases` placed by `instances`; `quality` is
+    /// the top level's build quality.
+    ///
+    /// # Panics
+    ///
+    /// If an instance names a bottom level that does not exist, or there
+    /// are more than 2³² primitives.
+    pub fn new(blases: Vec<Blas>, instances: Vec<Instance>, quality: BuildQuality) -> Self {
+        let start = Instant::now();
+        let mut bases = Vec::with_capacity(blases.len());
+        let mut next = 0u32;
+        for b in &blases {
+            bases.push(next);
+            next = next
+                .checked_add(b.len() as u32)
+                .expect("fewer than 2^32 primitives");
+        }
+        assert!(instances.iter().all(|i| (i.blas as usize) < blases.len()));
+        let direct = matches!(
+            instances.as_slice(),
+            [Instance {
+                blas: 0,
+                place: Place::Identity
+            }]
+        );
+        let mut accel = Self {
+            blases,
+            bases,
+            instances,
+            tlas: Hierarchy::default(),
+            tlas_items: Vec::new(),
+            direct,
+            quality,
             avx2: Avx2::detected(),
-            build_time: start.elapsed(),
+            build_time: Duration::default(),
         };
+        accel.build_top_level();
+        accel.build_time = start.elapsed();
+        accel
+    }
+
+    /// One bottom level over `prims` in render space, as its only instance;
+    /// returns it and, for each leaf-order index, the index of the
+    /// primitive in `prims`.
+    pub fn build(prims: &[Primitive], quality: BuildQuality) -> (Self, Vec<u32>) {
+        let start = Instant::now();
+        let blas = Blas::build(prims, None, quality);
+        let order = blas.order().to_vec();
+        let instance = Instance {
+            blas: 0,
+            place: Place::Identity,
+        };
+        let mut accel = Self::new(vec![blas], vec![instance], quality);
+        accel.build_time = start.elapsed();
         (accel, order)
     }
 
-    /// The primitives, in BVH order.
-    pub fn primitives(&self) -> &[Primitive] {
-        &self.prims
+    /// The instances' boxes in render space (containing their motion).
+    fn instance_boxes(&self) -> Vec<Option<Aabb>> {
+        self.instances
+            .iter()
+            .map(|i| {
+                let b = self.blases[i.blas as usize].bounds()?;
+                let placed = match &i.place {
+                    Place::Identity => b,
+                    Place::Fixed(p) => p.bounds(&b),
+                    Place::Moving(m) => m.bounds(&b),
+                };
+                (placed.min.is_finite() && placed.max.is_finite()).then_some(placed)
+            })
+            .collect()
+    }
+
+    fn build_top_level(&mut self) {
+        let boxes = self.instance_boxes();
+        let items = &mut self.tlas_items;
+        items.clear();
+        self.tlas = Hierarchy::build(&boxes, self.quality, LeafCost::INSTANCES, |leaf| {
+            store_instances(leaf, items)
+        });
+    }
+
+    /// Updates the top level after instances moved ([`Accel::instances_mut`])
+    /// or bottom levels changed ([`Accel::blas_mut`]): refits it, or
+    /// rebuilds it where the refit has degraded past `policy`.
+    pub fn update_top_level(&mut self, policy: UpdatePolicy) -> Update {
+        let start = Instant::now();
+        let boxes = self.instance_boxes();
+        let items = &mut self.tlas_items;
+        let mut fresh = Vec::new();
+        let mut update = self
+            .tlas
+            .update(&boxes, policy, |leaf| store_instances(leaf, &mut fresh));
+        if update.rebuilt {
+            *items = fresh;
+        }
+        update.time = start.elapsed();
+        self.build_time = update.time;
+        update
+    }
+
+    /// The instances, to move them (then call [`Accel::update_top_level`]).
+    pub fn instances_mut(&mut self) -> &mut [Instance] {
+        &mut self.instances
+    }
+
+    /// The instances.
+    pub fn instances(&self) -> &[Instance] {
+        &self.instances
+    }
+
+    /// Bottom level `i`, to update it (then call
+    /// [`Accel::update_top_level`]); its primitive count must stay.
+    pub fn blas_mut(&mut self, i: usize) -> &mut Blas {
+        &mut self.blases[i]
+    }
+
+    /// The bottom levels.
+    pub fn blases(&self) -> &[Blas] {
+        &self.blases
+    }
+
+    /// The number of the first primitive of bottom level `i`.
+    pub fn base(&self, i: usize) -> u32 {
+        self.bases[i]
+    }
+
+    /// The top level (for its SAH cost).
+    pub fn top_level(&self) -> &Hierarchy {
+        &self.tlas
+    }
+
+    /// The primitive `hit` found, in its bottom level's space at shutter
+    /// time `tau`, with the instance's placement there (`None`: the
+    /// primitive is in render space).
+    #[inline]
+    pub fn primitive(&self, hit: &Hit, tau: f32) -> (Primitive, Option<Placement>) {
+        if self.direct {
+            return (self.blases[0].primitive(hit.prim as usize, tau), None);
+        }
+        let inst = &self.instances[hit.inst as usize];
+        let blas = inst.blas as usize;
+        let local = (hit.prim - self.bases[blas]) as usize;
+        let prim = self.blases[blas].primitive(local, tau);
+        (prim, inst.place.at(tau))
     }
 
     /// Finds the closest hit along `origin + t·dir` for `t` in (0, `tmax`).
     #[inline]
     pub fn intersect(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Option<Hit> {
+        self.intersect_at(origin, dir, tmax, 0.0)
+    }
+
+    /// [`Accel::intersect`] at shutter time `tau`.
+    #[inline]
+    pub fn intersect_at(&self, origin: Vec3, dir: Vec3, tmax: f32, tau: f32) -> Option<Hit> {
         #[cfg(target_arch = "x86_64")]
         let hit = if self.avx2 {
             // SAFETY: `avx2` is set only where the CPU supports AVX2.
-            unsafe { self.intersect_avx2(origin, dir, tmax) }
+            unsafe { self.intersect_avx2(origin, dir, tmax, tau) }
         } else {
-            self.intersect_with::<Baseline>(origin, dir, tmax)
+            self.closest_with::<Baseline>(origin, dir, tmax, tau)
         };
         #[cfg(not(target_arch = "x86_64"))]
-        let hit = self.intersect_with::<Baseline>(origin, dir, tmax);
+        let hit = self.closest_with::<Baseline>(origin, dir, tmax, tau);
         (hit.prim != Hit::MISS.prim).then_some(hit)
     }
 
     /// Whether anything blocks `origin + t·dir` for `t` in (0, `tmax`).
     #[inline]
     pub fn occluded(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+        self.occluded_at(origin, dir, tmax, 0.0)
+    }
+
+    /// [`Accel::occluded`] at shutter time `tau`.
+    #[inline]
+    pub fn occluded_at(&self, origin: Vec3, dir: Vec3, tmax: f32, tau: f32) -> bool {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
             // SAFETY: `avx2` is set only where the CPU supports AVX2.
-            return unsafe { self.occluded_avx2(origin, dir, tmax) };
+            return unsafe { self.occluded_avx2(origin, dir, tmax, tau) };
         }
-        self.occluded_with::<Baseline>(origin, dir, tmax)
+        self.any_with::<Baseline>(origin, dir, tmax, tau)
     }
 
     /// Closest hits of a batch of rays: for each `slot` in `slots`, the ray
-    /// `origins[slot] + t·dirs[slot]`, t in (0, ∞), gets its hit in
-    /// `hits[slot]` ([`Hit::MISS`] if it hits nothing). The instruction
-    /// set is chosen once for the batch and the loop compiled for it.
+    /// `origins[slot] + t·dirs[slot]`, t in (0, ∞), at shutter time
+    /// `times[slot]` (0 without `times`), gets its hit in `hits[slot]`
+    /// ([`Hit::MISS`] if it hits nothing). The instruction set is chosen
+    /// once for the batch and the loop compiled for it.
     ///
     /// # Panics
     ///
-    /// If a slot is out of bounds of `origins`, `dirs` or `hits`.
+    /// If a slot is out of bounds of `origins`, `dirs`, `times` or `hits`.
     pub fn intersect_slots(
         &self,
         slots: &[u32],
         origins: &[Vec3],
         dirs: &[Vec3],
+        times: Option<&[f32]>,
         hits: &mut [Hit],
     ) {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
             // SAFETY: `avx2` is set only where the CPU supports AVX2.
-            return unsafe { self.intersect_slots_avx2(slots, origins, dirs, hits) };
+            return unsafe { self.intersect_slots_avx2(slots, origins, dirs, times, hits) };
         }
-        self.intersect_slots_with::<Baseline>(slots, origins, dirs, hits);
+        self.intersect_slots_with::<Baseline>(slots, origins, dirs, times, hits);
     }
 
     /// For a batch of shadow rays `origins[j] + t·dirs[j]`, t in
-    /// (0, `tmax`): whether anything blocks ray `j`, in `blocked[j]`. The
-    /// instruction set is chosen once for the batch.
+    /// (0, `tmax`), at shutter time `times[j]` (0 without `times`): whether
+    /// anything blocks ray `j`, in `blocked[j]`. The instruction set is
+    /// chosen once for the batch.
     ///
     /// # Panics
     ///
-    /// If the three slices differ in length.
-    pub fn occluded_each(&self, origins: &[Vec3], dirs: &[Vec3], tmax: f32, blocked: &mut [bool]) {
+    /// If the slices differ in length.
+    pub fn occluded_each(
+        &self,
+        origins: &[Vec3],
+        dirs: &[Vec3],
+        times: Option<&[f32]>,
+        tmax: f32,
+        blocked: &mut [bool],
+    ) {
         assert!(origins.len() == dirs.len() && dirs.len() == blocked.len());
+        assert!(times.is_none_or(|t| t.len() == origins.len()));
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
             // SAFETY: `avx2` is set only where the CPU supports AVX2.
-            return unsafe { self.occluded_each_avx2(origins, dirs, tmax, blocked) };
+            return unsafe { self.occluded_each_avx2(origins, dirs, times, tmax, blocked) };
         }
-        self.occluded_each_with::<Baseline>(origins, dirs, tmax, blocked);
+        self.occluded_each_with::<Baseline>(origins, dirs, times, tmax, blocked);
     }
 
-    /// [`Self::intersect`] compiled for AVX2.
+    /// [`Self::intersect_at`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn intersect_avx2(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Hit {
-        self.intersect_with::<Avx2>(origin, dir, tmax)
+    fn intersect_avx2(&self, origin: Vec3, dir: Vec3, tmax: f32, tau: f32) -> Hit {
+        self.closest_with::<Avx2>(origin, dir, tmax, tau)
     }
 
-    /// [`Self::occluded`] compiled for AVX2.
+    /// [`Self::occluded_at`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn occluded_avx2(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
-        self.occluded_with::<Avx2>(origin, dir, tmax)
+    fn occluded_avx2(&self, origin: Vec3, dir: Vec3, tmax: f32, tau: f32) -> bool {
+        self.any_with::<Avx2>(origin, dir, tmax, tau)
     }
 
     /// [`Self::intersect_slots`] compiled for AVX2.
@@ -303,16 +390,24 @@ impl Accel {
         slots: &[u32],
         origins: &[Vec3],
         dirs: &[Vec3],
+        times: Option<&[f32]>,
         hits: &mut [Hit],
     ) {
-        self.intersect_slots_with::<Avx2>(slots, origins, dirs, hits);
+        self.intersect_slots_with::<Avx2>(slots, origins, dirs, times, hits);
     }
 
     /// [`Self::occluded_each`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn occluded_each_avx2(&self, origins: &[Vec3], dirs: &[Vec3], tmax: f32, blocked: &mut [bool]) {
-        self.occluded_each_with::<Avx2>(origins, dirs, tmax, blocked);
+    fn occluded_each_avx2(
+        &self,
+        origins: &[Vec3],
+        dirs: &[Vec3],
+        times: Option<&[f32]>,
+        tmax: f32,
+        blocked: &mut [bool],
+    ) {
+        self.occluded_each_with::<Avx2>(origins, dirs, times, tmax, blocked);
     }
 
     /// [`Self::intersect_slots`] with the instruction set `I`.
@@ -322,11 +417,22 @@ impl Accel {
         slots: &[u32],
         origins: &[Vec3],
         dirs: &[Vec3],
+        times: Option<&[f32]>,
         hits: &mut [Hit],
     ) {
-        for &slot in slots {
-            let i = slot as usize;
-            hits[i] = self.intersect_with::<I>(origins[i], dirs[i], f32::INFINITY);
+        match times {
+            None => {
+                for &slot in slots {
+                    let i = slot as usize;
+                    hits[i] = self.closest_with::<I>(origins[i], dirs[i], f32::INFINITY, 0.0);
+                }
+            }
+            Some(times) => {
+                for &slot in slots {
+                    let i = slot as usize;
+                    hits[i] = self.closest_with::<I>(origins[i], dirs[i], f32::INFINITY, times[i]);
+                }
+            }
         }
     }
 
@@ -336,11 +442,22 @@ impl Accel {
         &self,
         origins: &[Vec3],
         dirs: &[Vec3],
+        times: Option<&[f32]>,
         tmax: f32,
         blocked: &mut [bool],
     ) {
-        for ((b, &o), &d) in blocked.iter_mut().zip(origins).zip(dirs) {
-            *b = self.occluded_with::<I>(o, d, tmax);
+        match times {
+            None => {
+                for ((b, &o), &d) in blocked.iter_mut().zip(origins).zip(dirs) {
+                    *b = self.any_with::<I>(o, d, tmax, 0.0);
+                }
+            }
+            Some(times) => {
+                let rays = origins.iter().zip(dirs).zip(times);
+                for (b, ((&o, &d), &tau)) in blocked.iter_mut().zip(rays) {
+                    *b = self.any_with::<I>(o, d, tmax, tau);
+                }
+            }
         }
     }
 
@@ -351,88 +468,106 @@ impl Accel {
         self.avx2 = false;
     }
 
-    /// [`Self::intersect`] with the instruction set `I`; [`Hit::MISS`]
-    /// where nothing is hit.
+    /// The closest hit with the instruction set `I`; [`Hit::MISS`] where
+    /// nothing is hit.
     #[inline(always)]
-    fn intersect_with<I: Isa>(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Hit {
-        if self.bvh.is_empty() || !ray_is_valid(origin, dir, tmax) {
+    fn closest_with<I: Isa>(&self, origin: Vec3, dir: Vec3, tmax: f32, tau: f32) -> Hit {
+        if self.direct {
+            // Instance 0 of bottom level 0, whose primitives start at 0.
+            return self.blases[0].closest::<I>(origin, dir, tmax, tau, 0);
+        }
+        if self.tlas.wide.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return Hit::MISS;
         }
-        let prep = RayPrep::new(origin, dir);
-        let mut query = Query::new(&self.packets, origin, dir, &prep);
-        self.bvh
+        let mut query = TopQuery {
+            accel: self,
+            origin,
+            dir,
+            tau,
+            best: Hit::MISS,
+            isa: PhantomData::<I>,
+        };
+        self.tlas
+            .wide
             .closest::<I>(&RayBoxes::new(origin, dir), tmax, &mut query);
         query.best
     }
 
-    /// [`Self::occluded`] with the instruction set `I`.
+    /// Whether anything is hit, with the instruction set `I`.
     #[inline(always)]
-    fn occluded_with<I: Isa>(&self, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
-        if self.bvh.is_empty() || !ray_is_valid(origin, dir, tmax) {
+    fn any_with<I: Isa>(&self, origin: Vec3, dir: Vec3, tmax: f32, tau: f32) -> bool {
+        if self.direct {
+            return self.blases[0].any::<I>(origin, dir, tmax, tau);
+        }
+        if self.tlas.wide.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return false;
         }
-        let prep = RayPrep::new(origin, dir);
-        let mut query = Query::new(&self.packets, origin, dir, &prep);
-        self.bvh
+        let mut query = TopQuery {
+            accel: self,
+            origin,
+            dir,
+            tau,
+            best: Hit::MISS,
+            isa: PhantomData::<I>,
+        };
+        self.tlas
+            .wide
             .any::<I>(&RayBoxes::new(origin, dir), tmax, &mut query)
     }
 }
 
-/// One ray's query at the leaves: its packets, its per-ray constants and
-/// the closest hit so far.
-struct Query<'a> {
-    packets: &'a [Packet],
-    origin: Vec3,
-    dir: Vec3,
-    prep: &'a RayPrep,
-    /// [`Hit::MISS`] until something is hit.
-    best: Hit,
+/// Stores one top-level leaf: its instances (input indices) in `items`;
+/// returns their range.
+fn store_instances(leaf: &[u32], items: &mut Vec<u32>) -> Range<u32> {
+    let start = items.len() as u32;
+    items.extend_from_slice(leaf);
+    start..items.len() as u32
 }
 
-impl<'a> Query<'a> {
+/// One ray's query of the top level: at each leaf, the ray enters each
+/// instance's space and traverses its bottom level.
+struct TopQuery<'a, I> {
+    accel: &'a Accel,
+    origin: Vec3,
+    dir: Vec3,
+    tau: f32,
+    best: Hit,
+    isa: PhantomData<I>,
+}
+
+impl<I: Isa> TopQuery<'_, I> {
+    /// The ray in instance `inst`'s space at the query's time: origin,
+    /// direction and how far the origin moved along the ray; `None` where
+    /// the instance cannot be entered (a singular transform).
     #[inline(always)]
-    fn new(packets: &'a [Packet], origin: Vec3, dir: Vec3, prep: &'a RayPrep) -> Self {
-        Self {
-            packets,
-            origin,
-            dir,
-            prep,
-            best: Hit::MISS,
+    fn enter(&self, inst: &Instance) -> Option<(Vec3, Vec3, f32)> {
+        match &inst.place {
+            Place::Identity => Some((self.origin, self.dir, 0.0)),
+            Place::Fixed(p) => Some(p.ray_to_object(self.origin, self.dir)),
+            Place::Moving(m) => Some(m.at(self.tau)?.ray_to_object(self.origin, self.dir)),
         }
     }
 }
 
-impl LeafVisitor for Query<'_> {
+impl<I: Isa> LeafVisitor for TopQuery<'_, I> {
     #[inline(always)]
     fn closest(&mut self, range: Range<usize>, mut tmax: f32) -> f32 {
-        for packet in &self.packets[range] {
-            match *packet {
-                Packet::Triangles { ref tris, first } => {
-                    if let Some(h) = tris.closest(self.prep, tmax) {
-                        tmax = h.t;
-                        self.best = Hit {
-                            t: h.t,
-                            prim: first + h.lane as u32,
-                            b1: h.b1,
-                            b2: h.b2,
-                        };
-                    }
-                }
-                Packet::Sphere {
-                    centre,
-                    radius,
-                    prim,
-                } => {
-                    if let Some(t) = hit_sphere(self.origin, self.dir, centre, radius, tmax) {
-                        tmax = t;
-                        self.best = Hit {
-                            t,
-                            prim,
-                            b1: 0.0,
-                            b2: 0.0,
-                        };
-                    }
-                }
+        let accel = self.accel;
+        for &i in &accel.tlas_items[range] {
+            let inst = &accel.instances[i as usize];
+            let Some((o, d, dt)) = self.enter(inst) else {
+                continue;
+            };
+            let blas = inst.blas as usize;
+            let base = accel.bases[blas];
+            let hit = accel.blases[blas].closest::<I>(o, d, tmax - dt, self.tau, base);
+            if hit.prim != Hit::MISS.prim {
+                tmax = hit.t + dt;
+                self.best = Hit {
+                    t: tmax,
+                    inst: i,
+                    ..hit
+                };
             }
         }
         tmax
@@ -440,14 +575,13 @@ impl LeafVisitor for Query<'_> {
 
     #[inline(always)]
     fn any(&mut self, range: Range<usize>, tmax: f32) -> bool {
-        for packet in &self.packets[range] {
-            let hit = match *packet {
-                Packet::Triangles { ref tris, .. } => tris.any(self.prep, tmax),
-                Packet::Sphere { centre, radius, .. } => {
-                    hit_sphere(self.origin, self.dir, centre, radius, tmax).is_some()
-                }
+        let accel = self.accel;
+        for &i in &accel.tlas_items[range] {
+            let inst = &accel.instances[i as usize];
+            let Some((o, d, dt)) = self.enter(inst) else {
+                continue;
             };
-            if hit {
+            if accel.blases[inst.blas as usize].any::<I>(o, d, tmax - dt, self.tau) {
                 return true;
             }
         }
@@ -465,16 +599,10 @@ fn ray_is_valid(origin: Vec3, dir: Vec3, tmax: f32) -> bool {
     zeros.cmpeq(Vec3A::ZERO).all() && tmax > 0.0
 }
 
-/// [`sphere::intersect`], kept out of the triangle loops so that they
-/// keep their registers (triangles are by far the common case).
-#[inline(never)]
-fn hit_sphere(origin: Vec3, dir: Vec3, centre: Vec3, radius: f32, tmax: f32) -> Option<f32> {
-    sphere::intersect(origin, dir, centre, radius, tmax)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use triangle::RayPrep;
 
     fn lcg(state: &mut u64) -> f32 {
         *state = state

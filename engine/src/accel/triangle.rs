@@ -112,6 +112,19 @@ impl Tri4 {
         Self { v }
     }
 
+    /// The triangles a fraction `s` of the way from these to `to` (vertex
+    /// by vertex, linearly: a deforming mesh under motion blur). Shared
+    /// vertices move identically, so the mesh stays watertight.
+    #[inline(always)]
+    pub fn lerp(&self, to: &Tri4, s: f32) -> Tri4 {
+        let s = Vec4::splat(s);
+        Tri4 {
+            v: std::array::from_fn(|i| {
+                std::array::from_fn(|a| self.v[i][a] + (to.v[i][a] - self.v[i][a]) * s)
+            }),
+        }
+    }
+
     /// The nearest hit with 0 < t < `tmax`, if any (the lowest lane among
     /// equally near ones).
     #[inline(always)]

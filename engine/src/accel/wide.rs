@@ -89,6 +89,20 @@ impl Node {
         }
     }
 
+    /// The box of `lane`, or `None` where the lane is unused (an empty box).
+    fn lane_box(&self, lane: usize) -> Option<Aabb> {
+        let corner = |side: usize| {
+            let b = &self.bounds[side];
+            Vec3A::new(
+                b[0][lane / 4][lane % 4],
+                b[1][lane / 4][lane % 4],
+                b[2][lane / 4][lane % 4],
+            )
+        };
+        let (min, max) = (corner(0), corner(1));
+        min.cmple(max).all().then_some(Aabb { min, max })
+    }
+
     /// Bit `lane` is set where the child is a leaf: the sign bits of
     /// `child`, read four lanes at a time (MOVMSKPS on x86_64).
     #[inline(always)]
@@ -343,6 +357,39 @@ pub trait LeafVisitor {
 #[derive(Debug, Clone, Default)]
 pub struct WideBvh {
     nodes: Vec<Node>,
+    /// Per node and lane: the binary node the lane was collapsed from
+    /// ([`NO_SOURCE`] for an unused lane), so that a refitted binary BVH
+    /// can hand its boxes to the wide one ([`WideBvh::refit`]).
+    sources: Vec<[u32; WIDTH]>,
+}
+
+/// An unused lane in [`WideBvh::sources`].
+const NO_SOURCE: u32 = u32::MAX;
+
+/// The cost model of a collapse: what testing a leaf of `count` primitives
+/// costs relative to testing one node, and how many primitives a leaf may
+/// hold.
+#[derive(Debug, Clone, Copy)]
+pub struct LeafCost {
+    /// Cost of a leaf by its primitive count.
+    pub cost: fn(u32) -> f32,
+    /// Primitives per leaf at most.
+    pub max_prims: u32,
+}
+
+impl LeafCost {
+    /// Triangles and spheres in packets of four: a packet costs a node.
+    pub const PACKETS: LeafCost = LeafCost {
+        cost: |count| count.div_ceil(4) as f32,
+        max_prims: 8,
+    };
+
+    /// Instances: each is a whole traversal of its own hierarchy, worth
+    /// several nodes; one per leaf.
+    pub const INSTANCES: LeafCost = LeafCost {
+        cost: |count| 4.0 * count as f32,
+        max_prims: 1,
+    };
 }
 
 impl WideBvh {
@@ -350,26 +397,28 @@ impl WideBvh {
     /// receives the primitives (as indices into `bvh2`'s input) of each
     /// leaf, stores them, and returns the range of items that traversal
     /// hands back for that leaf.
-    pub fn build(bvh2: &Bvh2, mut leaf: impl FnMut(&[u32]) -> Range<u32>) -> Self {
+    pub fn build(bvh2: &Bvh2, cost: LeafCost, mut leaf: impl FnMut(&[u32]) -> Range<u32>) -> Self {
         if bvh2.nodes.is_empty() {
             return Self::default();
         }
-        let plan = Collapse::new(bvh2);
+        let plan = Collapse::new(bvh2, cost);
         let mut nodes = vec![Node::EMPTY];
+        let mut sources = vec![[NO_SOURCE; WIDTH]];
         let mut prims = Vec::new();
-        let mut make_leaf = |node: &mut Node, lane: usize, binary: usize| {
+        let mut make_leaf = |node: &mut Node, source: &mut u32, lane: usize, binary: usize| {
             prims.clear();
             push_primitives(bvh2, binary, &mut prims);
             let range = leaf(&prims);
             if !range.is_empty() {
                 let aabb = bvh2.nodes[binary].aabb();
                 node.set_lane(lane, aabb, range.start, Some(range.len() as u32));
+                *source = binary as u32;
             }
         };
         if bvh2.nodes[0].is_leaf() {
             // A single leaf: one lane of the root holds it.
-            make_leaf(&mut nodes[0], 0, 0);
-            return Self { nodes };
+            make_leaf(&mut nodes[0], &mut sources[0][0], 0, 0);
+            return Self { nodes, sources };
         }
         // (binary node, wide node it becomes, depth of that wide node)
         let mut work = vec![(0, 0, 1)];
@@ -379,16 +428,95 @@ impl WideBvh {
             plan.children(binary, &mut children);
             for (lane, &(c, is_leaf)) in children.iter().enumerate() {
                 if is_leaf || depth >= MAX_DEPTH {
-                    make_leaf(&mut nodes[wide], lane, c);
+                    make_leaf(&mut nodes[wide], &mut sources[wide][lane], lane, c);
                 } else {
                     let index = nodes.len();
                     nodes.push(Node::EMPTY);
+                    sources.push([NO_SOURCE; WIDTH]);
                     nodes[wide].set_lane(lane, bvh2.nodes[c].aabb(), index as u32, None);
+                    sources[wide][lane] = c as u32;
                     work.push((c, index, depth + 1));
                 }
             }
         }
-        Self { nodes }
+        Self { nodes, sources }
+    }
+
+    /// Takes the boxes of `bvh2` — the binary BVH this one was collapsed
+    /// from, refitted since — for every lane (the tree's shape and leaves
+    /// stay as they are).
+    pub fn refit(&mut self, bvh2: &Bvh2) {
+        for (node, sources) in self.nodes.iter_mut().zip(&self.sources) {
+            for (lane, &source) in sources.iter().enumerate() {
+                if source != NO_SOURCE {
+                    let aabb = bvh2.nodes[source as usize].aabb();
+                    let (child, count) = (node.child[lane], node.count[lane]);
+                    node.set_lane(
+                        lane,
+                        aabb,
+                        child & !LEAF,
+                        (child & LEAF != 0).then_some(count),
+                    );
+                }
+            }
+        }
+    }
+
+    /// The expected cost of a random ray's traversal under the surface
+    /// area heuristic, in units of a node test: Σ over nodes of their area
+    /// plus Σ over leaves of their area × `cost`, over the area of the
+    /// whole tree. Refitting a tree to moved primitives makes it grow;
+    /// comparing it with the cost at the last build says when to rebuild.
+    pub fn sah_cost(&self, cost: LeafCost) -> f32 {
+        let Some(root) = self.bounds() else {
+            return 0.0;
+        };
+        let root_area = root.half_area();
+        if !(root_area > 0.0) {
+            return 0.0;
+        }
+        let mut total = root_area * NODE_COST;
+        for node in &self.nodes {
+            for lane in 0..WIDTH {
+                let Some(aabb) = node.lane_box(lane) else {
+                    continue;
+                };
+                let weight = if node.child[lane] & LEAF != 0 {
+                    (cost.cost)(node.count[lane])
+                } else {
+                    NODE_COST
+                };
+                total += aabb.half_area() * weight;
+            }
+        }
+        total / root_area
+    }
+
+    /// The box around everything, or `None` for an empty hierarchy.
+    pub fn bounds(&self) -> Option<Aabb> {
+        let root = self.nodes.first()?;
+        let mut lanes = (0..WIDTH).filter_map(|lane| root.lane_box(lane));
+        let first = lanes.next()?;
+        Some(lanes.fold(first, |a, b| a.union(&b)))
+    }
+
+    /// Every used lane, for tests: (node index, box, the item range of a
+    /// leaf or `None`, the child node index of a node).
+    #[cfg(test)]
+    pub fn lanes(&self) -> Vec<(usize, Aabb, Option<Range<usize>>, usize)> {
+        let mut out = Vec::new();
+        for (index, node) in self.nodes.iter().enumerate() {
+            for lane in 0..WIDTH {
+                if let Some(aabb) = node.lane_box(lane) {
+                    if node.child[lane] & LEAF != 0 {
+                        out.push((index, aabb, Some(node.items(lane)), 0));
+                    } else {
+                        out.push((index, aabb, None, node.child[lane] as usize));
+                    }
+                }
+            }
+        }
+        out
     }
 
     /// Whether the BVH holds no primitives.
@@ -475,9 +603,6 @@ impl WideBvh {
 /// relative to testing a packet of four triangles.
 const NODE_COST: f32 = 1.0;
 
-/// Primitives per leaf at most (two packets).
-const MAX_LEAF_PRIMS: u32 = 8;
-
 /// The cheapest way to collapse a binary BVH into `WIDTH`-wide nodes, by
 /// dynamic programming over its subtrees (Ylitie et al., "Efficient
 /// Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", 2017,
@@ -496,7 +621,7 @@ struct Collapse<'a> {
 }
 
 impl<'a> Collapse<'a> {
-    fn new(bvh2: &'a Bvh2) -> Self {
+    fn new(bvh2: &'a Bvh2, leaf_cost: LeafCost) -> Self {
         let n = bvh2.nodes.len();
         // Children before parents: the reverse of a preorder.
         let mut order = Vec::with_capacity(n);
@@ -517,7 +642,7 @@ impl<'a> Collapse<'a> {
         for &i in order.iter().rev() {
             let node = &bvh2.nodes[i];
             let area = node.aabb().half_area();
-            let packets = |count: u32| count.div_ceil(4) as f32;
+            let packets = leaf_cost.cost;
             if node.is_leaf() {
                 prims[i] = node.prim_count;
                 cost[i] = [area * packets(node.prim_count); WIDTH];
@@ -536,7 +661,7 @@ impl<'a> Collapse<'a> {
             let (children_cost, k) = best_split(WIDTH);
             node_split[i] = k;
             let as_node = area * NODE_COST + children_cost;
-            let as_one_leaf = if prims[i] <= MAX_LEAF_PRIMS {
+            let as_one_leaf = if prims[i] <= leaf_cost.max_prims {
                 area * packets(prims[i])
             } else {
                 f32::INFINITY

@@ -151,6 +151,8 @@ impl Setting {
         let mut overrides = *base;
         match &self.change {
             Change::MaxDepth(d) => overrides.max_depth = Some(*d),
+            Change::RrDepth(d) => overrides.rr_depth = Some(*d),
+            Change::FilterSampling(f) => overrides.filter_sampling = Some(*f),
             Change::LightSelection(l) => overrides.light_selection = Some(*l),
             Change::Bvh(q) => overrides.bvh = Some(*q),
             _ => {}
@@ -164,13 +166,7 @@ impl Setting {
         let render = extract(scene, registry, &overrides);
         scene.filter = filter;
         scene.sampler = sampler;
-        let mut render = render?;
-        match self.change {
-            Change::RrDepth(d) => render.settings.rr_depth = d,
-            Change::FilterSampling(f) => render.settings.filter_sampling = f,
-            _ => {}
-        }
-        Ok(render)
+        Ok(render?)
     }
 }
 

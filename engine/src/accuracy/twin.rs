@@ -4,9 +4,10 @@
 
 use super::metrics::Halves;
 use crate::backend::cpu::{Progress, render_samples};
+use crate::error::{SceneError, module_error};
 use crate::extract::RenderScene;
 use crate::film::{Film, Image};
-use crate::scene::{Scene, SceneError, module_error};
+use crate::scene::Scene;
 use glam::UVec2;
 use radiant_core::{BuildContext, Registry, Sampler, TextureTable};
 use std::collections::HashMap;

@@ -2,7 +2,7 @@
 //! chooses one per next-event estimate, proportional to power or uniform
 //! ([`LightSelection`]).
 
-use crate::scene::LightSelection;
+use crate::settings::LightSelection;
 use radiant_core::{Effects, Light};
 
 /// The scene's lights with their selection probabilities.

@@ -7,7 +7,8 @@
 //! of the named materials being built catches a material that contains
 //! itself, and bounds how deep named materials may nest.
 
-use crate::scene::{Scene, module_error, module_spec};
+use crate::error::module_error;
+use crate::scene::{Scene, module_spec};
 use marked_yaml::Node;
 use radiant_core::registry::ModuleType;
 use radiant_core::{BuildContext, MaterialSource, ModuleKind, ParamError, Registry, Shader};

@@ -14,9 +14,10 @@ mod shapes;
 pub use lights::LightTable;
 
 use crate::accel::{Accel, BuildQuality, Primitive};
-use crate::scene::{
-    LightSelection, MAX_FILM_SIZE, RenderSettings, Scene, SceneError, module_error,
-};
+use crate::error::{SceneError, module_error};
+use crate::scene::Scene;
+pub use crate::settings::Overrides;
+use crate::settings::RenderSettings;
 use crate::world::{
     CameraPose, EmitterSpec, FlippedNormals, Geometry, LightSpec, MaterialRef, MeshRepairs,
     ModuleSpec, Name, Transform,
@@ -30,28 +31,7 @@ use radiant_core::{
 };
 use shapes::{ShapePrim, tessellate};
 use std::collections::{BTreeSet, HashMap};
-use std::path::Path;
 use std::time::Duration;
-
-/// Command-line overrides of the scene's settings.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Overrides {
-    /// Samples per pixel.
-    pub spp: Option<u32>,
-    /// Maximum path depth.
-    pub max_depth: Option<i32>,
-    /// Sampler seed.
-    pub seed: Option<u64>,
-    /// Film width.
-    pub width: Option<u32>,
-    /// Film height.
-    pub height: Option<u32>,
-    /// Light selection of next-event estimation.
-    pub light_selection: Option<LightSelection>,
-    /// BVH build quality (default: [`BuildQuality::default_for`] the
-    /// scene's primitive count).
-    pub bvh: Option<BuildQuality>,
-}
 
 /// "No emitter" in [`Surfaces::emitter`].
 pub const NO_EMITTER: u32 = u32::MAX;
@@ -144,31 +124,6 @@ impl Builder<'_> {
     }
 }
 
-/// Rejects overrides outside the ranges a scene file allows.
-fn check_overrides(file: &Path, o: &Overrides) -> Result<(), SceneError> {
-    let error = |what: String| Err(SceneError::new(file, None, what));
-    for (key, value) in [("width", o.width), ("height", o.height)] {
-        if let Some(v) = value
-            && !(1..=MAX_FILM_SIZE).contains(&v)
-        {
-            return error(format!(
-                "the film {key} override must be between 1 and {MAX_FILM_SIZE} pixels, found {v}"
-            ));
-        }
-    }
-    if o.spp == Some(0) {
-        return error("the spp override must be at least 1".into());
-    }
-    if let Some(d) = o.max_depth
-        && d < -1
-    {
-        return error(format!(
-            "the max_depth override must be -1 (unlimited) or at least 0, found {d}"
-        ));
-    }
-    Ok(())
-}
-
 /// Builds the render data of `scene`'s current frame.
 pub fn extract(
     scene: &Scene,
@@ -176,16 +131,10 @@ pub fn extract(
     overrides: &Overrides,
 ) -> Result<RenderScene, SceneError> {
     let file = &scene.file;
-    check_overrides(file, overrides)?;
-    let mut settings = scene.settings;
-    settings.spp = overrides.spp.unwrap_or(settings.spp);
-    settings.max_depth = overrides.max_depth.unwrap_or(settings.max_depth);
-    settings.seed = overrides.seed.unwrap_or(settings.seed);
-    settings.width = overrides.width.unwrap_or(settings.width);
-    settings.height = overrides.height.unwrap_or(settings.height);
-    settings.light_selection = overrides
-        .light_selection
-        .unwrap_or(settings.light_selection);
+    let settings = scene
+        .settings
+        .with(overrides)
+        .map_err(|e| SceneError::new(file, None, e.to_string()))?;
 
     let pose = {
         let mut query = scene.world.query::<&CameraPose>();

@@ -11,7 +11,7 @@
 
 pub mod output;
 
-use crate::scene::FilterSampling;
+use crate::settings::FilterSampling;
 use glam::{Vec2, Vec4};
 use radiant_core::{Filter, FilterSampler, Rgb};
 

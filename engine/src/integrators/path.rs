@@ -306,7 +306,7 @@ impl Wavefront {
     fn trace_closest(&mut self, scene: &RenderScene) {
         scene
             .accel
-            .intersect_slots(&self.live, &self.origin, &self.dir, &mut self.hit);
+            .intersect_slots(&self.live, &self.origin, &self.dir, None, &mut self.hit);
         self.rays += self.live.len() as u64;
     }
 
@@ -334,7 +334,7 @@ impl Wavefront {
                 }
                 continue;
             }
-            its[i] = interaction(scene, &hit, origin[i], dir[i]);
+            its[i] = interaction(scene, &hit, origin[i], dir[i], 0.0);
             if has_area && emitter[hit.prim as usize] != NO_EMITTER {
                 emitting[em] = slot;
                 em += 1;
@@ -625,6 +625,7 @@ impl Wavefront {
         scene.accel.occluded_each(
             &self.shadow_origin,
             &self.shadow_dir,
+            None,
             1.0 - SHADOW_EPSILON,
             &mut self.shadow_blocked,
         );

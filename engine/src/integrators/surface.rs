@@ -1,7 +1,7 @@
 //! Surface interactions: what the shading stages need to know about a hit.
 
 use crate::accel::offset::{sphere_error, triangle_point};
-use crate::accel::{Hit, Primitive};
+use crate::accel::{Hit, Placement, Primitive};
 use crate::extract::RenderScene;
 use glam::{Vec2, Vec3};
 use radiant_core::Frame;
@@ -40,15 +40,59 @@ fn above_tangent_plane(ns: Vec3, ng: Vec3) -> Vec3 {
     }
 }
 
-/// Resolves `hit` of the ray `origin + t·dir`.
+/// Resolves `hit` of the ray `origin + t·dir` at shutter time `tau`.
 #[inline]
-pub fn interaction(scene: &RenderScene, hit: &Hit, origin: Vec3, dir: Vec3) -> Interaction {
+pub fn interaction(
+    scene: &RenderScene,
+    hit: &Hit,
+    origin: Vec3,
+    dir: Vec3,
+    tau: f32,
+) -> Interaction {
+    let (prim, placement) = scene.accel.primitive(hit, tau);
+    match placement {
+        None => local_interaction(scene, prim, hit, origin, dir, None),
+        Some(place) => {
+            // In the instance's space (the ray as the query saw it), then
+            // out to render space with the transform's rounding error.
+            let (o, d, _) = place.ray_to_object(origin, dir);
+            let it = local_interaction(scene, prim, hit, o, d, Some(&place));
+            let (p, err) = place.point_to_render(it.p, it.err);
+            let ng = place.normal_to_render(it.ng);
+            let ns = place.normal_to_render(it.frame.n);
+            let ns = if ns == Vec3::ZERO { ng } else { ns };
+            Interaction {
+                p,
+                err,
+                ng,
+                frame: Frame::from_normal(above_tangent_plane(ns, ng)),
+                uv: it.uv,
+            }
+        }
+    }
+}
+
+/// The interaction with `prim` in its own space. Face frames are stored
+/// for primitives in render space only; a placed primitive's frame is
+/// made from its normal (its tangents are turned by the placement anyway).
+#[inline(always)]
+fn local_interaction(
+    scene: &RenderScene,
+    prim: Primitive,
+    hit: &Hit,
+    origin: Vec3,
+    dir: Vec3,
+    placed: Option<&Placement>,
+) -> Interaction {
     let i = hit.prim as usize;
-    match scene.accel.primitives()[i] {
+    match prim {
         Primitive::Triangle(v) => {
             let b0 = 1.0 - hit.b1 - hit.b2;
             let (p, err) = triangle_point(&v, b0, hit.b1, hit.b2);
-            let face = scene.surfaces.face_frames[i];
+            let face = match placed {
+                None => scene.surfaces.face_frames[i],
+                Some(_) => Frame::from_normal((v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero()),
+            };
             let ng = face.n;
             let n = scene.surfaces.normals[i];
             let frame = if n[0] == Vec3::ZERO {

@@ -23,12 +23,12 @@
 //! Every error names the file, line and column, what was expected and what
 //! is allowed. Relative paths are resolved against the scene file's folder.
 
-mod error;
 pub mod obj;
 pub mod transform;
 mod yaml;
 
-pub use error::SceneError;
+pub use crate::error::SceneError;
+pub use crate::settings::{FilterSampling, LightSelection, MAX_FILM_SIZE, RenderSettings};
 
 use crate::world::{
     CameraPose, EmitterSpec, FlippedNormals, Geometry, LightSpec, MaterialRef, ModuleSpec, Name,
@@ -43,60 +43,6 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 pub(crate) use yaml::module_spec;
 use yaml::{Mapping, closest, loc, parse_node};
-
-/// The largest film width or height in pixels, in a scene file or as an
-/// override.
-pub const MAX_FILM_SIZE: u32 = 1 << 15;
-
-/// How a frame is rendered: the scene's integrator, film and sampler
-/// settings (command-line options may override them).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct RenderSettings {
-    /// Film width in pixels.
-    pub width: u32,
-    /// Film height in pixels.
-    pub height: u32,
-    /// Samples per pixel.
-    pub spp: u32,
-    /// Longest path in segments (Mitsuba 3 semantics); -1 for no limit.
-    pub max_depth: i32,
-    /// Depth from which Russian roulette may end paths.
-    pub rr_depth: u32,
-    /// Seed of the sampler.
-    pub seed: u64,
-    /// How next-event estimation chooses a light.
-    pub light_selection: LightSelection,
-    /// How samples reach the pixels through the pixel filter.
-    pub filter_sampling: FilterSampling,
-}
-
-/// How the film applies the pixel filter (`film: {filter_sampling: …}`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum FilterSampling {
-    /// Each sample is placed uniformly in its pixel and added to every
-    /// pixel within the filter's radius, weighted by the filter; a pixel is
-    /// Σ f·L / Σ f (Mitsuba 3). Wide filters cost more per sample.
-    #[default]
-    Splat,
-    /// Each sample's offset from its pixel's centre is drawn in proportion
-    /// to |f| and the sample is added to that pixel alone with weight
-    /// f/pdf (pbrt-v4): any filter costs what `box` costs, pixels are
-    /// uncorrelated, and the noise per sample is somewhat higher.
-    Importance,
-}
-
-/// How next-event estimation chooses among the scene's lights
-/// (`integrator: {light_selection: …}`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum LightSelection {
-    /// In proportion to each light's emitted power.
-    #[default]
-    Power,
-    /// Every light equally likely.
-    Uniform,
-}
 
 /// A loaded scene: the world plus the settings and module definitions that
 /// are not entities.
@@ -664,18 +610,5 @@ fn parse_material_ref(
             materials.push((format!("<material of {shape_name}>"), spec));
             Ok(MaterialRef(materials.len() as u32 - 1))
         }
-    }
-}
-
-/// Turns a registry error about module `spec` into a scene error.
-pub(crate) fn module_error(
-    file: &Path,
-    spec: &ModuleSpec,
-    err: radiant_core::registry::BuildError,
-) -> SceneError {
-    use radiant_core::registry::BuildError;
-    match err {
-        BuildError::UnknownType { .. } => SceneError::new(file, spec.location, err.to_string()),
-        BuildError::Params(p) => SceneError::new(file, p.location.or(spec.location), p.message),
     }
 }

@@ -5,8 +5,10 @@
 //! parameters stay unparsed ([`ModuleSpec`]) until extract, because modules
 //! are built in render space, which depends on the camera.
 
+mod animation;
 mod components;
 
+pub use animation::{Interpolation, Key, Keyable, Track, TrackError, TransformTracks, Trs, slerp};
 pub use components::{
     CameraPose, EmitterSpec, FlippedNormals, Geometry, LightSpec, MaterialRef, MeshData,
     MeshRepairs, ModuleSpec, Name, Transform,

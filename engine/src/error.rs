@@ -1,5 +1,8 @@
-//! Scene errors: what is wrong, in which file, at which line and column.
+//! Errors in what a user wrote: what is wrong, in which file, at which line
+//! and column. The scene loader raises them while it reads a scene, extract
+//! while it builds the scene's modules and animates it.
 
+use crate::world::ModuleSpec;
 use radiant_core::ParamError;
 use radiant_core::params::Location;
 use std::fmt;
@@ -49,3 +52,16 @@ impl fmt::Display for SceneError {
 }
 
 impl std::error::Error for SceneError {}
+
+/// Turns a registry error about module `spec` into a scene error.
+pub(crate) fn module_error(
+    file: &Path,
+    spec: &ModuleSpec,
+    err: radiant_core::registry::BuildError,
+) -> SceneError {
+    use radiant_core::registry::BuildError;
+    match err {
+        BuildError::UnknownType { .. } => SceneError::new(file, spec.location, err.to_string()),
+        BuildError::Params(p) => SceneError::new(file, p.location.or(spec.location), p.message),
+    }
+}

@@ -1,0 +1,454 @@
+//! The bottom level: one hierarchy over the primitives of a shape (or of
+//! all static shapes together), in that hierarchy's own space.
+//!
+//! Primitives are stored in leaf order, triangles as packets of four
+//! ([`Tri4`]) tested together with SIMD. A deforming mesh is refitted as
+//! its vertices move ([`Blas::update`]); under motion blur it keeps its
+//! triangles at shutter open and close and intersects them where they are
+//! at each ray's time.
+
+use super::hierarchy::{Hierarchy, Update, UpdatePolicy};
+use super::triangle::{RayPrep, Tri4};
+use super::wide::{Isa, LeafCost, LeafVisitor, RayBoxes};
+use super::{Hit, Primitive, ray_is_valid, sphere};
+use crate::settings::BuildQuality;
+use glam::{Vec3, Vec3A};
+use obvhs::aabb::Aabb;
+use std::ops::Range;
+
+/// What a leaf holds: triangles four at a time, or one sphere.
+#[derive(Debug, Clone, Copy)]
+enum Packet {
+    /// Up to four triangles: `count` primitives from `first` on.
+    Triangles { tris: Tri4, first: u32, count: u32 },
+    /// A sphere, primitive `prim`.
+    Sphere {
+        centre: Vec3,
+        radius: f32,
+        prim: u32,
+    },
+}
+
+/// The primitives at shutter close, for geometry that deforms while the
+/// shutter is open.
+#[derive(Clone)]
+struct Closing {
+    packets: Vec<Packet>,
+    prims: Vec<Primitive>,
+}
+
+/// A bottom-level hierarchy and its primitives in leaf order.
+#[derive(Clone, Default)]
+pub struct Blas {
+    hierarchy: Hierarchy,
+    packets: Vec<Packet>,
+    prims: Vec<Primitive>,
+    closing: Option<Closing>,
+    /// Per leaf-order index, the index of the primitive in the input.
+    order: Vec<u32>,
+}
+
+impl Blas {
+    /// Builds the hierarchy over `prims` (and, for geometry that deforms
+    /// while the shutter is open, their shapes at shutter close, `close`,
+    /// of the same length: a box then contains both).
+    ///
+    /// # Panics
+    ///
+    /// If `close` is not as long as `prims`.
+    pub fn build(prims: &[Primitive], close: Option<&[Primitive]>, quality: BuildQuality) -> Self {
+        let mut blas = Self::default();
+        blas.rebuild(prims, close, quality);
+        blas
+    }
+
+    fn rebuild(&mut self, prims: &[Primitive], close: Option<&[Primitive]>, quality: BuildQuality) {
+        let boxes = boxes(prims, close);
+        let (mut order, mut packets) = (Vec::with_capacity(prims.len()), Vec::new());
+        let hierarchy = Hierarchy::build(&boxes, quality, LeafCost::PACKETS, |leaf| {
+            store_leaf(leaf, prims, &mut order, &mut packets)
+        });
+        debug_assert_eq!(order.len(), prims.len());
+        self.hierarchy = hierarchy;
+        self.prims = order.iter().map(|&i| prims[i as usize]).collect();
+        self.closing = close.map(|close| closing(close, &order, &packets));
+        self.packets = packets;
+        self.order = order;
+    }
+
+    /// Follows primitives that moved: `prims` (and `close`, as in
+    /// [`Blas::build`]) are the new shapes of the primitives given to the
+    /// last build, in the same input order. Refits, or rebuilds where the
+    /// refitted tree has degraded past `policy` — then [`Blas::order`]
+    /// changes, and so must the shading data laid out by it.
+    ///
+    /// # Panics
+    ///
+    /// If the primitive count changed.
+    pub fn update(
+        &mut self,
+        prims: &[Primitive],
+        close: Option<&[Primitive]>,
+        policy: UpdatePolicy,
+    ) -> Update {
+        assert_eq!(prims.len(), self.order.len(), "the primitive count changed");
+        let boxes = boxes(prims, close);
+        let (mut order, mut packets) = (Vec::new(), Vec::new());
+        let update = self.hierarchy.update(&boxes, policy, |leaf| {
+            store_leaf(leaf, prims, &mut order, &mut packets)
+        });
+        if update.rebuilt {
+            self.order = order;
+            self.packets = packets;
+        } else {
+            // Same leaves, same order: repack the moved triangles.
+            repack(&mut self.packets, prims, &self.order);
+        }
+        self.prims = self.order.iter().map(|&i| prims[i as usize]).collect();
+        self.closing = close.map(|close| closing(close, &self.order, &self.packets));
+        update
+    }
+
+    /// Per leaf-order index, the index of the primitive in the input of the
+    /// last build.
+    pub fn order(&self) -> &[u32] {
+        &self.order
+    }
+
+    /// Number of primitives.
+    pub fn len(&self) -> usize {
+        self.prims.len()
+    }
+
+    /// Whether there are no primitives.
+    pub fn is_empty(&self) -> bool {
+        self.prims.is_empty()
+    }
+
+    /// Whether the primitives move while the shutter is open.
+    pub fn deforms(&self) -> bool {
+        self.closing.is_some()
+    }
+
+    /// The hierarchy (for its SAH cost and bounds).
+    pub fn hierarchy(&self) -> &Hierarchy {
+        &self.hierarchy
+    }
+
+    /// The box around the primitives at every shutter time.
+    pub fn bounds(&self) -> Option<Aabb> {
+        self.hierarchy.wide.bounds()
+    }
+
+    /// Primitive `i` (leaf order) at shutter time `tau` (triangles of a
+    /// deforming mesh are interpolated vertex by vertex).
+    #[inline]
+    pub fn primitive(&self, i: usize, tau: f32) -> Primitive {
+        match (&self.closing, self.prims[i]) {
+            (Some(c), Primitive::Triangle(a)) => match c.prims[i] {
+                Primitive::Triangle(b) => {
+                    Primitive::Triangle(std::array::from_fn(|k| a[k] + (b[k] - a[k]) * tau))
+                }
+                Primitive::Sphere(..) => self.prims[i],
+            },
+            (_, p) => p,
+        }
+    }
+
+    /// The closest hit of `origin + t·dir` within `tmax` at shutter time
+    /// `tau`, its primitive numbered from `base`; [`Hit::MISS`] if none.
+    #[inline(always)]
+    pub(super) fn closest<I: Isa>(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        tmax: f32,
+        tau: f32,
+        base: u32,
+    ) -> Hit {
+        if self.packets.is_empty() || !ray_is_valid(origin, dir, tmax) {
+            return Hit::MISS;
+        }
+        let prep = RayPrep::new(origin, dir);
+        let boxes = RayBoxes::new(origin, dir);
+        match &self.closing {
+            None => {
+                let mut query = Query::<false>::new(&self.packets, &[], 0.0, origin, dir, &prep);
+                query.base = base;
+                self.hierarchy.wide.closest::<I>(&boxes, tmax, &mut query);
+                query.best
+            }
+            Some(c) => {
+                let mut query =
+                    Query::<true>::new(&self.packets, &c.packets, tau, origin, dir, &prep);
+                query.base = base;
+                self.hierarchy.wide.closest::<I>(&boxes, tmax, &mut query);
+                query.best
+            }
+        }
+    }
+
+    /// Whether anything blocks `origin + t·dir` for t in (0, `tmax`) at
+    /// shutter time `tau`.
+    #[inline(always)]
+    pub(super) fn any<I: Isa>(&self, origin: Vec3, dir: Vec3, tmax: f32, tau: f32) -> bool {
+        if self.packets.is_empty() || !ray_is_valid(origin, dir, tmax) {
+            return false;
+        }
+        let prep = RayPrep::new(origin, dir);
+        let boxes = RayBoxes::new(origin, dir);
+        match &self.closing {
+            None => {
+                let mut query = Query::<false>::new(&self.packets, &[], 0.0, origin, dir, &prep);
+                self.hierarchy.wide.any::<I>(&boxes, tmax, &mut query)
+            }
+            Some(c) => {
+                let mut query =
+                    Query::<true>::new(&self.packets, &c.packets, tau, origin, dir, &prep);
+                self.hierarchy.wide.any::<I>(&boxes, tmax, &mut query)
+            }
+        }
+    }
+}
+
+/// The boxes of `prims` (containing their shapes at shutter close too).
+fn boxes(prims: &[Primitive], close: Option<&[Primitive]>) -> Vec<Option<Aabb>> {
+    match close {
+        None => prims.iter().map(Primitive::aabb).collect(),
+        Some(close) => {
+            assert_eq!(close.len(), prims.len(), "open and close differ in length");
+            prims
+                .iter()
+                .zip(close)
+                .map(|(a, b)| Some(a.aabb()?.union(&b.aabb()?)))
+                .collect()
+        }
+    }
+}
+
+/// Stores one leaf of input primitives `leaf`: triangles first, in
+/// packets of four, then spheres; returns its range of packets.
+fn store_leaf(
+    leaf: &[u32],
+    prims: &[Primitive],
+    order: &mut Vec<u32>,
+    packets: &mut Vec<Packet>,
+) -> Range<u32> {
+    let start = packets.len() as u32;
+    let (tris, spheres): (Vec<u32>, Vec<u32>) = leaf
+        .iter()
+        .partition(|&&i| matches!(prims[i as usize], Primitive::Triangle(_)));
+    for chunk in tris.chunks(4) {
+        let first = order.len() as u32;
+        order.extend_from_slice(chunk);
+        packets.push(Packet::Triangles {
+            tris: pack(chunk.iter().map(|&i| prims[i as usize])),
+            first,
+            count: chunk.len() as u32,
+        });
+    }
+    for &i in &spheres {
+        if let Primitive::Sphere(centre, radius) = prims[i as usize] {
+            packets.push(Packet::Sphere {
+                centre,
+                radius,
+                prim: order.len() as u32,
+            });
+            order.push(i);
+        }
+    }
+    start..packets.len() as u32
+}
+
+/// The triangles among `prims` as one packet.
+fn pack(prims: impl Iterator<Item = Primitive>) -> Tri4 {
+    let mut vertices = [[Vec3::ZERO; 3]; 4];
+    let mut n = 0;
+    for p in prims {
+        if let Primitive::Triangle(v) = p {
+            vertices[n] = v;
+            n += 1;
+        }
+    }
+    Tri4::new(&vertices[..n])
+}
+
+/// Rewrites the triangle packets with the primitives' new shapes `prims`
+/// (input order), keeping the leaf order `order`.
+fn repack(packets: &mut [Packet], prims: &[Primitive], order: &[u32]) {
+    for packet in packets {
+        if let Packet::Triangles { tris, first, count } = packet {
+            let members = &order[*first as usize..(*first + *count) as usize];
+            *tris = pack(members.iter().map(|&i| prims[i as usize]));
+        }
+    }
+}
+
+/// The packets of the shapes at shutter close `close` (input order),
+/// laid out as the packets at shutter open, `open`.
+fn closing(close: &[Primitive], order: &[u32], open: &[Packet]) -> Closing {
+    let mut packets = open.to_vec();
+    repack(&mut packets, close, order);
+    for p in &mut packets {
+        if let Packet::Sphere {
+            centre,
+            radius,
+            prim,
+        } = p
+            && let Primitive::Sphere(c, r) = close[order[*prim as usize] as usize]
+        {
+            (*centre, *radius) = (c, r);
+        }
+    }
+    Closing {
+        packets,
+        prims: order.iter().map(|&i| close[i as usize]).collect(),
+    }
+}
+
+/// One ray's query at the leaves: its packets (and, where `MOVING`,
+/// their shapes at shutter close with the ray's time), its per-ray
+/// constants and the closest hit so far. The flag is a constant so that
+/// static geometry's loops carry no test for motion.
+struct Query<'a, const MOVING: bool> {
+    packets: &'a [Packet],
+    closing: &'a [Packet],
+    tau: f32,
+    origin: Vec3,
+    dir: Vec3,
+    prep: &'a RayPrep,
+    /// Number of the first primitive, added to hits.
+    base: u32,
+    /// [`Hit::MISS`] until something is hit.
+    best: Hit,
+}
+
+impl<'a, const MOVING: bool> Query<'a, MOVING> {
+    #[inline(always)]
+    fn new(
+        packets: &'a [Packet],
+        closing: &'a [Packet],
+        tau: f32,
+        origin: Vec3,
+        dir: Vec3,
+        prep: &'a RayPrep,
+    ) -> Self {
+        Self {
+            packets,
+            closing,
+            tau,
+            origin,
+            dir,
+            prep,
+            base: 0,
+            best: Hit::MISS,
+        }
+    }
+
+    /// The triangles of packet `i`, `tris`, at the ray's time.
+    #[inline(always)]
+    fn tris(&self, i: usize, tris: &Tri4) -> Tri4 {
+        if !MOVING {
+            return *tris;
+        }
+        match &self.closing[i] {
+            Packet::Triangles { tris: end, .. } => tris.lerp(end, self.tau),
+            Packet::Sphere { .. } => *tris,
+        }
+    }
+}
+
+impl<const MOVING: bool> LeafVisitor for Query<'_, MOVING> {
+    #[inline(always)]
+    fn closest(&mut self, range: Range<usize>, mut tmax: f32) -> f32 {
+        for i in range {
+            match self.packets[i] {
+                Packet::Triangles {
+                    ref tris, first, ..
+                } => {
+                    let hit = if MOVING {
+                        self.tris(i, tris).closest(self.prep, tmax)
+                    } else {
+                        tris.closest(self.prep, tmax)
+                    };
+                    if let Some(h) = hit {
+                        tmax = h.t;
+                        self.best = Hit {
+                            t: h.t,
+                            prim: self.base + first + h.lane as u32,
+                            inst: 0,
+                            b1: h.b1,
+                            b2: h.b2,
+                        };
+                    }
+                }
+                Packet::Sphere {
+                    centre,
+                    radius,
+                    prim,
+                } => {
+                    if let Some(t) = hit_sphere(self.origin, self.dir, centre, radius, tmax) {
+                        tmax = t;
+                        self.best = Hit {
+                            t,
+                            prim: self.base + prim,
+                            inst: 0,
+                            b1: 0.0,
+                            b2: 0.0,
+                        };
+                    }
+                }
+            }
+        }
+        tmax
+    }
+
+    #[inline(always)]
+    fn any(&mut self, range: Range<usize>, tmax: f32) -> bool {
+        for i in range {
+            let hit = match self.packets[i] {
+                Packet::Triangles { ref tris, .. } => {
+                    if MOVING {
+                        self.tris(i, tris).any(self.prep, tmax)
+                    } else {
+                        tris.any(self.prep, tmax)
+                    }
+                }
+                Packet::Sphere { centre, radius, .. } => {
+                    hit_sphere(self.origin, self.dir, centre, radius, tmax).is_some()
+                }
+            };
+            if hit {
+                return true;
+            }
+        }
+        false
+    }
+}
+
+/// [`sphere::intersect`], kept out of the triangle loops so that they
+/// keep their registers (triangles are by far the common case).
+#[inline(never)]
+fn hit_sphere(origin: Vec3, dir: Vec3, centre: Vec3, radius: f32, tmax: f32) -> Option<f32> {
+    sphere::intersect(origin, dir, centre, radius, tmax)
+}
+
+/// The box of `p`, or `None` where a coordinate is not finite.
+impl Primitive {
+    pub(super) fn aabb(&self) -> Option<Aabb> {
+        let aabb = match *self {
+            Primitive::Triangle([a, b, c]) => {
+                let a = Vec3A::from(a);
+                let b = Vec3A::from(b);
+                let c = Vec3A::from(c);
+                Aabb::new(a.min(b).min(c), a.max(b).max(c))
+            }
+            Primitive::Sphere(c, r) => {
+                let c = Vec3A::from(c);
+                let r = Vec3A::splat(r.abs());
+                Aabb::new(c - r, c + r)
+            }
+        };
+        (aabb.min.is_finite() && aabb.max.is_finite()).then_some(aabb)
+    }
+}

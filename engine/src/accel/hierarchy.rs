@@ -1,0 +1,177 @@
+//! A bounding volume hierarchy that can follow its primitives as they
+//! move: built by obvhs, collapsed into the wide BVH rays traverse, and
+//! refitted — the tree kept, every box recomputed — when the primitives
+//! move, until its SAH cost has grown past a threshold, when it is built
+//! anew ([`UpdatePolicy`]).
+//!
+//! Both levels of the accelerator use it: a deforming mesh's bottom level
+//! over triangles, and the top level over instances.
+
+use super::wide::{LeafCost, WideBvh};
+use crate::settings::BuildQuality;
+use glam::Vec3A;
+use obvhs::BvhBuildParams;
+use obvhs::aabb::Aabb;
+use obvhs::bvh2::Bvh2;
+use std::ops::Range;
+use std::time::{Duration, Instant};
+
+/// When a refitted hierarchy is rebuilt.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UpdatePolicy {
+    /// Rebuild once the SAH cost after a refit exceeds the cost at the
+    /// last build by this factor.
+    pub rebuild_above: f32,
+}
+
+impl Default for UpdatePolicy {
+    /// Rebuild at 1.3× the built cost (see the README's animation
+    /// benchmark: refitting costs a few percent of a rebuild, and tracing
+    /// time follows the SAH cost).
+    fn default() -> Self {
+        Self { rebuild_above: 1.3 }
+    }
+}
+
+/// What an update of a hierarchy did.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Update {
+    /// Whether it was built anew (its primitives' order changed).
+    pub rebuilt: bool,
+    /// SAH cost after the update over the cost at the last build.
+    pub degradation: f32,
+    /// Time the update took.
+    pub time: Duration,
+}
+
+/// obvhs' parameters for the binary BVH of `quality`.
+fn params(quality: BuildQuality) -> BvhBuildParams {
+    let mut params = match quality {
+        BuildQuality::Fast => BvhBuildParams::fast_build(),
+        BuildQuality::Medium => BvhBuildParams::medium_build(),
+        BuildQuality::High => BvhBuildParams::slow_build(),
+    };
+    // One primitive per leaf: the wide BVH's collapse picks the leaves.
+    params.max_prims_per_leaf = 1;
+    params
+}
+
+/// Boxes for the builder: a primitive without a finite box gets a point box
+/// inside the scene, so that it cannot spoil the boxes above it (such a
+/// primitive is never hit).
+fn usable(boxes: &[Option<Aabb>]) -> Vec<Aabb> {
+    let somewhere = boxes.iter().flatten().next().map_or(Vec3A::ZERO, |b| b.min);
+    let point = Aabb::new(somewhere, somewhere);
+    boxes.iter().map(|b| b.unwrap_or(point)).collect()
+}
+
+/// A wide BVH with the binary one it was collapsed from (kept for refits).
+#[derive(Clone, Default)]
+pub struct Hierarchy {
+    /// What rays traverse.
+    pub wide: WideBvh,
+    bvh2: Bvh2,
+    cost: Option<LeafCost>,
+    quality: Option<BuildQuality>,
+    built_cost: f32,
+}
+
+impl Hierarchy {
+    /// Builds a hierarchy over primitives with boxes `boxes` (`None` where
+    /// a primitive has no finite box). `leaf` receives each leaf's
+    /// primitives (input indices), stores them, and returns the range of
+    /// items traversal hands back for that leaf.
+    pub fn build(
+        boxes: &[Option<Aabb>],
+        quality: BuildQuality,
+        cost: LeafCost,
+        leaf: impl FnMut(&[u32]) -> Range<u32>,
+    ) -> Self {
+        if boxes.is_empty() {
+            return Self::default();
+        }
+        let mut core_time = Duration::default();
+        let bvh2 =
+            obvhs::bvh2::builder::build_bvh2(&usable(boxes), params(quality), &mut core_time);
+        let wide = WideBvh::build(&bvh2, cost, leaf);
+        let built_cost = wide.sah_cost(cost);
+        Self {
+            wide,
+            bvh2,
+            cost: Some(cost),
+            quality: Some(quality),
+            built_cost,
+        }
+    }
+
+    /// Refits every box to the primitives' new boxes `boxes` (by input
+    /// index, as given to [`Hierarchy::build`]); the tree and the leaves'
+    /// contents stay. Returns the SAH cost over the cost at the last build.
+    pub fn refit(&mut self, boxes: &[Option<Aabb>]) -> f32 {
+        let Some(cost) = self.cost else {
+            return 1.0;
+        };
+        let boxes = usable(boxes);
+        let bvh2 = &mut self.bvh2;
+        for node in bvh2.nodes.iter_mut().filter(|n| n.is_leaf()) {
+            let first = node.first_index as usize;
+            let prims = &bvh2.primitive_indices[first..first + node.prim_count as usize];
+            let aabb = prims
+                .iter()
+                .fold(Aabb::empty(), |a, &p| a.union(&boxes[p as usize]));
+            node.set_aabb(aabb);
+        }
+        bvh2.refit_all();
+        self.wide.refit(bvh2);
+        self.degradation_of(cost)
+    }
+
+    /// The SAH cost now over the cost at the last build.
+    fn degradation_of(&self, cost: LeafCost) -> f32 {
+        if self.built_cost > 0.0 {
+            self.wide.sah_cost(cost) / self.built_cost
+        } else {
+            1.0
+        }
+    }
+
+    /// Follows primitives that moved to `boxes`: refits, and rebuilds (with
+    /// `leaf` storing the new leaves, as in [`Hierarchy::build`]) where the
+    /// refitted tree's SAH cost has grown past `policy`.
+    pub fn update(
+        &mut self,
+        boxes: &[Option<Aabb>],
+        policy: UpdatePolicy,
+        leaf: impl FnMut(&[u32]) -> Range<u32>,
+    ) -> Update {
+        let start = Instant::now();
+        let degradation = self.refit(boxes);
+        if degradation <= policy.rebuild_above {
+            return Update {
+                rebuilt: false,
+                degradation,
+                time: start.elapsed(),
+            };
+        }
+        let (Some(quality), Some(cost)) = (self.quality, self.cost) else {
+            return Update::default();
+        };
+        *self = Self::build(boxes, quality, cost, leaf);
+        Update {
+            rebuilt: true,
+            degradation: 1.0,
+            time: start.elapsed(),
+        }
+    }
+
+    /// The SAH cost now over the cost at the last build (1 right after a
+    /// build).
+    pub fn degradation(&self) -> f32 {
+        self.cost.map_or(1.0, |c| self.degradation_of(c))
+    }
+
+    /// The SAH cost of the wide tree.
+    pub fn sah_cost(&self) -> f32 {
+        self.cost.map_or(0.0, |c| self.wide.sah_cost(c))
+    }
+}
