@@ -191,18 +191,21 @@ impl Accel {
 
     /// The instances' boxes in render space (containing their motion).
     fn instance_boxes(&self) -> Vec<Option<Aabb>> {
-        self.instances
-            .iter()
-            .map(|i| {
-                let b = self.blases[i.blas as usize].bounds()?;
-                let placed = match &i.place {
-                    Place::Identity => b,
-                    Place::Fixed(p) => p.bounds(&b),
-                    Place::Moving(m) => m.bounds(&b),
-                };
-                (placed.min.is_finite() && placed.max.is_finite()).then_some(placed)
-            })
+        (0..self.instances.len())
+            .map(|i| self.instance_bounds(i))
             .collect()
+    }
+
+    /// The render-space box of instance `i` (containing its motion).
+    pub fn instance_bounds(&self, i: usize) -> Option<Aabb> {
+        let inst = &self.instances[i];
+        let b = self.blases[inst.blas as usize].bounds()?;
+        let placed = match &inst.place {
+            Place::Identity => b,
+            Place::Fixed(p) => p.bounds(&b),
+            Place::Moving(m) => m.bounds(&b),
+        };
+        (placed.min.is_finite() && placed.max.is_finite()).then_some(placed)
     }
 
     fn build_top_level(&mut self) {

@@ -5,6 +5,43 @@ use radiant::Registry;
 use radiant::extract::{Overrides, extract};
 use std::path::Path;
 
+/// What besides shapes animates: the camera, lights, materials and
+/// textures with keyframes.
+fn animated_modules(scene: &radiant::scene::Scene) -> Vec<String> {
+    use radiant::world::{CameraAnimation, CameraPose, EmitterSpec, LightSpec};
+    let mut out = Vec::new();
+    let world = &scene.world;
+    for (pose, animation) in world
+        .query::<(&CameraPose, Option<&CameraAnimation>)>()
+        .iter()
+    {
+        if animation.is_some() || !pose.module.tracks.is_empty() {
+            out.push(format!("camera {}", pose.module.type_name));
+        }
+    }
+    for (spec, moving) in world
+        .query::<(&LightSpec, Option<&radiant::world::Animation>)>()
+        .iter()
+    {
+        if moving.is_some() || !spec.0.tracks.is_empty() {
+            out.push(format!("light {}", spec.0.type_name));
+        }
+    }
+    for spec in world.query::<&EmitterSpec>().iter() {
+        if !spec.0.tracks.is_empty() {
+            out.push(format!("emitter {}", spec.0.type_name));
+        }
+    }
+    for (kind, list) in [("texture", &scene.textures), ("material", &scene.materials)] {
+        for (name, spec) in list.iter() {
+            if !spec.tracks.is_empty() {
+                out.push(format!("{kind} {name}"));
+            }
+        }
+    }
+    out
+}
+
 /// Prints counts, modules and effects of the scene at `path`.
 pub fn run(registry: &Registry, path: &Path) -> miette::Result<()> {
     let scene = radiant::scene::load(path).map_err(report)?;
@@ -46,6 +83,35 @@ pub fn run(registry: &Registry, path: &Path) -> miette::Result<()> {
     println!(
         "bvh build    {:.3} ms",
         r.stats.bvh_build.as_secs_f64() * 1e3
+    );
+    let t = &scene.timeline;
+    let shutter = match t.shutter {
+        Some((open, close)) => format!("shutter [{open}, {close}] frames (motion blur)"),
+        None => "no shutter".to_string(),
+    };
+    println!(
+        "animation    frames {}..{} ({} at {} fps), {shutter}",
+        t.start,
+        t.end,
+        t.len(),
+        t.fps
+    );
+    let st = &r.stats;
+    let animated = animated_modules(&scene);
+    println!(
+        "animated     {} shapes moving, {} deforming meshes, {} other entities and modules with keyframes{}",
+        st.animated_shapes,
+        st.deforming_meshes,
+        animated.len(),
+        if animated.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", animated.join(", "))
+        }
+    );
+    println!(
+        "instances    {} in the top level ({} instanced shapes), {} triangles placed",
+        st.instances, st.instanced_shapes, st.instanced_triangles
     );
     Ok(())
 }

@@ -1,4 +1,5 @@
-//! `radiant render`: render a scene to an image file.
+//! `radiant render`: render a scene, or a range of its frames, to image
+//! files.
 
 use super::diagnostic::report;
 use super::film_args::FilmArgs;
@@ -6,63 +7,146 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use radiant::Registry;
 use radiant::backend::cpu::{self, Progress};
-use radiant::extract::{Overrides, extract};
-use std::path::PathBuf;
+use radiant::extract::{Overrides, Sequence, SequenceOptions};
+use radiant::world::systems::substitute_frame;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 /// Options of `radiant render`.
 #[derive(Args)]
 pub struct RenderArgs {
     /// The scene file (YAML).
     scene: PathBuf,
-    /// Output image: .png (tone-mapped sRGB) or .exr (linear float RGB).
+    /// Output image: .png (tone-mapped sRGB) or .exr (linear float RGB). A
+    /// run of `#` in the name becomes the frame number, zero-padded to the
+    /// run's length (`out/frame_####.png`).
     #[arg(short, long)]
     output: PathBuf,
+    /// The frames to render: `A..B` (inclusive) or one frame `N` (default:
+    /// the scene's first frame).
+    #[arg(long, value_parser = parse_frames)]
+    frames: Option<(i64, i64)>,
+    /// Leave frames whose output file exists (files are written whole or
+    /// not at all, so an existing one is finished): resumes an interrupted
+    /// sequence.
+    #[arg(long)]
+    skip_existing: bool,
+    /// Use the base seed in every frame (the same noise pattern in each,
+    /// for A/B comparisons) instead of one seed per frame.
+    #[arg(long)]
+    lock_noise: bool,
     /// Samples per pixel, at least 1 (overrides the scene's sampler).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     spp: Option<u32>,
     /// Longest path in segments; -1 for unlimited (overrides the scene).
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(i32).range(-1..))]
     max_depth: Option<i32>,
-    /// Sampler seed.
+    /// Sampler seed (of the scene's first frame; the others derive theirs).
     #[arg(long)]
     seed: Option<u64>,
     #[command(flatten)]
     film: FilmArgs,
 }
 
-/// Renders as the arguments say.
-pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
-    let ext = args
-        .output
+/// Parses `A..B` or `N`.
+fn parse_frames(text: &str) -> Result<(i64, i64), String> {
+    let number = |s: &str| {
+        s.trim()
+            .parse::<i64>()
+            .map_err(|_| format!("`{s}` is not a frame number; expected A..B or N"))
+    };
+    let (a, b) = match text.split_once("..") {
+        Some((a, b)) => (number(a)?, number(b.trim_start_matches('='))?),
+        None => {
+            let n = number(text)?;
+            (n, n)
+        }
+    };
+    if b < a {
+        return Err(format!(
+            "the range {a}..{b} is empty; expected A..B with A ≤ B"
+        ));
+    }
+    Ok((a, b))
+}
+
+/// Checks that `output` can be written: a .png or .exr name in a folder
+/// that exists.
+fn check_output(output: &Path) -> miette::Result<()> {
+    let ext = output
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     if !matches!(ext.as_deref(), Some("png" | "exr")) {
         miette::bail!(
             "cannot write `{}`: the output name must end in .png or .exr",
-            args.output.display()
+            output.display()
         );
     }
-    if args.output.is_dir() {
-        miette::bail!("cannot write `{}`: it is a folder", args.output.display());
+    if output.is_dir() {
+        miette::bail!("cannot write `{}`: it is a folder", output.display());
     }
-    if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty()) {
+    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
         if !dir.exists() {
             miette::bail!(
                 "cannot write `{}`: the folder `{}` does not exist",
-                args.output.display(),
+                output.display(),
                 dir.display()
             );
         }
         if !dir.is_dir() {
             miette::bail!(
                 "cannot write `{}`: `{}` is not a folder",
-                args.output.display(),
+                output.display(),
                 dir.display()
             );
         }
     }
-    let scene = radiant::scene::load(&args.scene).map_err(report)?;
+    Ok(())
+}
+
+/// The output file of `frame`.
+fn frame_path(output: &Path, frame: i64) -> PathBuf {
+    let name = output
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    output.with_file_name(substitute_frame(&name, frame))
+}
+
+/// Time spent per phase of a sequence.
+#[derive(Default)]
+struct Totals {
+    frames: u64,
+    skipped: u64,
+    update: Duration,
+    bvh: Duration,
+    render: Duration,
+}
+
+/// Renders as the arguments say.
+pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
+    let pattern = args.output.to_string_lossy().contains('#');
+    check_output(&frame_path(&args.output, 0))?;
+    let mut scene = radiant::scene::load(&args.scene).map_err(report)?;
+    let timeline = scene.timeline;
+    let (first, last) = args.frames.unwrap_or((timeline.start, timeline.start));
+    if !(timeline.contains(first) && timeline.contains(last)) {
+        miette::bail!(
+            "frames {first}..{last} are outside the scene's frames {}..{} (`animation: {{frames: [first, last]}}` in `{}` sets them)",
+            timeline.start,
+            timeline.end,
+            args.scene.display()
+        );
+    }
+    let sequence = args.frames.is_some();
+    if last > first && !pattern {
+        miette::bail!(
+            "cannot write {} frames to `{}`: put a run of `#` in the output name for the frame number, as in `out/frame_####.png`",
+            last - first + 1,
+            args.output.display()
+        );
+    }
     let overrides = Overrides {
         spp: args.spp,
         max_depth: args.max_depth,
@@ -71,39 +155,124 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         height: args.film.height,
         ..Default::default()
     };
-    let render_scene = extract(&scene, registry, &overrides).map_err(report)?;
-    for (shape, what) in &render_scene.stats.repaired_shapes {
-        eprintln!("warning: {shape}: {}", what.describe());
-    }
+    let options = SequenceOptions {
+        lock_noise: args.lock_noise,
+        ..SequenceOptions::default()
+    };
     let pool = args.film.thread_pool()?;
-
-    let s = &render_scene.settings;
-    let bar = ProgressBar::new(s.width as u64 * s.height as u64 * s.spp as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} eta {eta}")
-            .expect("the template is valid"),
-    );
-    let update = |done: u64, _total: u64| bar.set_position(done);
-    let rendered = pool.install(|| cpu::render(&render_scene, &Progress::new(&update)));
-    bar.finish_and_clear();
-
-    radiant::film::output::write(&args.output, &rendered.image)
-        .map_err(|e| miette::miette!("{e}"))?;
-    if rendered.invalid_samples > 0 {
+    let todo: Vec<i64> = (first..=last)
+        .filter(|&f| !(args.skip_existing && frame_path(&args.output, f).exists()))
+        .collect();
+    let mut totals = Totals {
+        skipped: (last - first + 1) as u64 - todo.len() as u64,
+        ..Totals::default()
+    };
+    let started = Instant::now();
+    let mut state: Option<Sequence> = None;
+    let mut bar: Option<ProgressBar> = None;
+    for &frame in &todo {
+        let update = match &mut state {
+            None => {
+                let (s, u) = Sequence::new(&mut scene, registry, &overrides, &options, frame)
+                    .map_err(report)?;
+                let r = s.scene();
+                for (shape, what) in &r.stats.repaired_shapes {
+                    eprintln!("warning: {shape}: {}", what.describe());
+                }
+                state = Some(s);
+                u
+            }
+            Some(s) => s.go_to(&mut scene, registry, frame).map_err(report)?,
+        };
+        let s = state.as_ref().expect("built above").scene();
+        let settings = &s.settings;
+        let per_frame = settings.width as u64 * settings.height as u64 * settings.spp as u64;
+        let bar = bar.get_or_insert_with(|| {
+            let bar = ProgressBar::new(per_frame * todo.len() as u64);
+            let template = if todo.len() > 1 {
+                "{msg} {bar:40} {percent:>3}% {elapsed_precise} eta {eta}"
+            } else {
+                "{bar:40} {percent:>3}% {elapsed_precise} eta {eta}"
+            };
+            bar.set_style(ProgressStyle::with_template(template).expect("the template is valid"));
+            bar
+        });
+        bar.set_message(format!("frame {frame}"));
+        let base = totals.frames * per_frame;
+        let progress = |done: u64, _total: u64| bar.set_position(base + done);
+        let rendered = pool.install(|| cpu::render(s, &Progress::new(&progress)));
+        let path = frame_path(&args.output, frame);
+        radiant::film::output::write(&path, &rendered.image).map_err(|e| miette::miette!("{e}"))?;
+        if rendered.invalid_samples > 0 {
+            bar.suspend(|| {
+                eprintln!(
+                    "warning: frame {frame}: {} samples were NaN or infinite and were recorded as black",
+                    rendered.invalid_samples
+                )
+            });
+        }
+        let secs = rendered.time.as_secs_f64();
+        let line = format!(
+            "rendered {}x{}, {} spp in {:.2} s ({:.2} Msamples/s, {:.2} Mrays/s)",
+            settings.width,
+            settings.height,
+            settings.spp,
+            secs,
+            rendered.samples as f64 / secs / 1e6,
+            rendered.rays as f64 / secs / 1e6
+        );
+        if sequence {
+            bar.suspend(|| {
+                eprintln!(
+                    "frame {frame}: {line}; scene update {:.1} ms (BVH {:.1} ms) → {}",
+                    update.update.as_secs_f64() * 1e3,
+                    update.bvh.as_secs_f64() * 1e3,
+                    path.display()
+                )
+            });
+        } else {
+            bar.suspend(|| eprintln!("{line}"));
+        }
+        totals.frames += 1;
+        totals.update += update.update;
+        totals.bvh += update.bvh;
+        totals.render += rendered.time;
+    }
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    if sequence {
         eprintln!(
-            "warning: {} samples were NaN or infinite and were recorded as black",
-            rendered.invalid_samples
+            "sequence: {} frames in {:.2} s (scene update {:.2} s, of which BVH update {:.2} s; rendering {:.2} s){}",
+            totals.frames,
+            started.elapsed().as_secs_f64(),
+            totals.update.as_secs_f64(),
+            totals.bvh.as_secs_f64(),
+            totals.render.as_secs_f64(),
+            if totals.skipped > 0 {
+                format!("; {} existing frames skipped", totals.skipped)
+            } else {
+                String::new()
+            }
         );
     }
-    let secs = rendered.time.as_secs_f64();
-    eprintln!(
-        "rendered {}x{}, {} spp in {:.2} s ({:.2} Msamples/s, {:.2} Mrays/s)",
-        s.width,
-        s.height,
-        s.spp,
-        secs,
-        rendered.samples as f64 / secs / 1e6,
-        rendered.rays as f64 / secs / 1e6
-    );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_ranges_parse() {
+        assert_eq!(parse_frames("1..10"), Ok((1, 10)));
+        assert_eq!(parse_frames("7"), Ok((7, 7)));
+        assert_eq!(parse_frames("-2..=3"), Ok((-2, 3)));
+        assert!(parse_frames("5..1").is_err());
+        assert!(parse_frames("a..b").is_err());
+        assert_eq!(
+            frame_path(Path::new("out/f_####.png"), 42),
+            Path::new("out/f_0042.png")
+        );
+    }
 }

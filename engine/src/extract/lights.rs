@@ -60,6 +60,20 @@ impl LightTable {
         }
     }
 
+    /// Puts each `(i, light)` of `replacements` in place of light `i`,
+    /// and chooses lights anew by `selection`.
+    pub fn replace(
+        &mut self,
+        replacements: Vec<(usize, Box<dyn Light>)>,
+        selection: LightSelection,
+    ) {
+        let mut lights = std::mem::take(&mut self.lights);
+        for (i, light) in replacements {
+            lights[i] = light;
+        }
+        *self = Self::new(lights, selection);
+    }
+
     /// The lights.
     pub fn lights(&self) -> &[Box<dyn Light>] {
         &self.lights

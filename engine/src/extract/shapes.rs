@@ -35,12 +35,15 @@ const CUBE_FACES: [(DVec3, DVec3, DVec3); 6] = [
 /// Tessellates `geometry` under `to_world`, then shifts it so that
 /// `render_origin` becomes the origin, appending to `out`. With `flip`, the
 /// front side of every triangle (its winding and shading normals) is turned
-/// round. Returns the triangles dropped as unusable in render space.
+/// round. Returns the triangles dropped as unusable in render space; with
+/// `keep_all` (the frames of a deforming mesh, which must keep their
+/// triangles), none are dropped: such triangles are never hit.
 pub(crate) fn tessellate(
     geometry: &Geometry,
     to_world: DMat4,
     render_origin: DVec3,
     flip: bool,
+    keep_all: bool,
     out: &mut Vec<ShapePrim>,
 ) -> MeshRepairs {
     let point = |p: DVec3| (to_world.transform_point3(p) - render_origin).as_vec3();
@@ -53,11 +56,11 @@ pub(crate) fn tessellate(
     let mut dropped = MeshRepairs::default();
     let mut push = |v: [Vec3; 3], n: [Vec3; 3], uv: [Vec2; 3]| {
         let normal = (v[1] - v[0]).cross(v[2] - v[0]);
-        if !(v.iter().all(|p| p.is_finite()) && normal.is_finite()) {
+        if !keep_all && !(v.iter().all(|p| p.is_finite()) && normal.is_finite()) {
             dropped.non_finite += 1;
             return;
         }
-        if normal.try_normalize().is_none() {
+        if !keep_all && normal.try_normalize().is_none() {
             dropped.degenerate += 1;
             return;
         }
@@ -140,6 +143,7 @@ mod tests {
             DMat4::IDENTITY,
             DVec3::ZERO,
             false,
+            false,
             &mut prims,
         );
         assert_eq!(prims.len(), 12);
@@ -159,7 +163,14 @@ mod tests {
             DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
         ] {
             let mut prims = Vec::new();
-            tessellate(&Geometry::Rectangle, m, DVec3::ZERO, false, &mut prims);
+            tessellate(
+                &Geometry::Rectangle,
+                m,
+                DVec3::ZERO,
+                false,
+                false,
+                &mut prims,
+            );
             for p in &prims {
                 assert!((face_normal(p) - Vec3::Z).length() < 1e-6);
             }
@@ -173,7 +184,7 @@ mod tests {
             DMat4::from_scale(DVec3::new(1.0, -1.0, 1.0)),
         ] {
             let mut prims = Vec::new();
-            let dropped = tessellate(&Geometry::Cube, m, DVec3::ZERO, true, &mut prims);
+            let dropped = tessellate(&Geometry::Cube, m, DVec3::ZERO, true, false, &mut prims);
             assert_eq!((prims.len(), dropped), (12, MeshRepairs::default()));
             for p in &prims {
                 let ShapePrim::Triangle { v, .. } = p else {
@@ -207,6 +218,7 @@ mod tests {
             DMat4::from_scale(DVec3::splat(1e-30)),
             DVec3::ZERO,
             false,
+            false,
             &mut prims,
         );
         assert_eq!((prims.len(), dropped.degenerate), (0, 2), "{dropped:?}");
@@ -216,11 +228,19 @@ mod tests {
             DMat4::from_scale(DVec3::splat(1e38)),
             DVec3::ZERO,
             false,
+            false,
             &mut prims,
         );
         assert_eq!((prims.len(), dropped.non_finite), (0, 2), "{dropped:?}");
         prims.clear();
-        let dropped = tessellate(&geometry, DMat4::IDENTITY, DVec3::ZERO, false, &mut prims);
+        let dropped = tessellate(
+            &geometry,
+            DMat4::IDENTITY,
+            DVec3::ZERO,
+            false,
+            false,
+            &mut prims,
+        );
         assert_eq!((prims.len(), dropped), (2, MeshRepairs::default()));
     }
 
@@ -232,6 +252,7 @@ mod tests {
             &Geometry::Rectangle,
             DMat4::from_translation(far) * DMat4::from_scale(DVec3::splat(1e-3)),
             far,
+            false,
             false,
             &mut prims,
         );

@@ -19,8 +19,8 @@
 
 use super::sort::sort_by_key;
 use super::surface::{Interaction, interaction};
-use crate::accel::Hit;
 use crate::accel::offset::{offset_origin, sampled_point_error};
+use crate::accel::{Hit, Motion};
 use crate::extract::{NO_EMITTER, RenderScene};
 use crate::film::{Reconstruction, TileFilm};
 use glam::{Vec2, Vec3};
@@ -29,7 +29,8 @@ use radiant_core::{
     ShadeContext, SurfaceBatch,
 };
 
-/// Sampler dimensions used by the camera (film jitter, lens).
+/// Sampler dimensions used by the camera (film jitter, lens); under motion
+/// blur one more, the time (so a still scene's dimensions are as they were).
 const CAMERA_DIMS: u32 = 4;
 /// Sampler dimensions used per bounce: light choice, light point (2),
 /// lobe choice, direction (2), Russian roulette, one spare.
@@ -70,6 +71,8 @@ pub struct Wavefront {
     filter_weight: Vec<f32>,
     origin: Vec<Vec3>,
     dir: Vec<Vec3>,
+    /// Shutter time τ in [0, 1) of each path (only under motion blur).
+    time: Vec<f32>,
     beta: Vec<Rgb>,
     /// Product of η² over the refractions so far (see [`BsdfSample::eta`]).
     eta_scale: Vec<f32>,
@@ -117,10 +120,22 @@ pub struct Wavefront {
     shadow_origin: Vec<Vec3>,
     shadow_dir: Vec<Vec3>,
     shadow_value: Vec<Rgb>,
+    /// Shutter time of each shadow ray (only under motion blur).
+    shadow_time: Vec<f32>,
     /// Per shadow ray: whether something blocks it.
     shadow_blocked: Vec<bool>,
     /// Rays traced so far (camera, continuation and shadow rays).
     pub rays: u64,
+}
+
+/// Moves camera rays to where the camera is at each path's shutter time:
+/// `motion` maps the camera's pose at the frame to its pose at τ.
+fn move_camera_rays(motion: &Motion, time: &[f32], origin: &mut [Vec3], dir: &mut [Vec3]) {
+    for ((o, d), &tau) in origin.iter_mut().zip(dir.iter_mut()).zip(time) {
+        let m = motion.matrix(f64::from(tau));
+        *o = m.transform_point3(o.as_dvec3()).as_vec3();
+        *d = m.transform_vector3(d.as_dvec3()).as_vec3().normalize();
+    }
 }
 
 /// Gives `v` length `n` for a stage that writes every element (old values
@@ -246,6 +261,16 @@ impl Wavefront {
                 weights: &mut self.u1,
             },
         );
+        if scene.motion_blur() {
+            // Each path lives at one time of the shutter (a box shutter).
+            fit(&mut self.time, n);
+            scene
+                .sampler
+                .fill_1d(&self.ids, CAMERA_DIMS, &mut self.time);
+            if let Some(motion) = &scene.camera_motion {
+                move_camera_rays(motion, &self.time, &mut self.origin, &mut self.dir);
+            }
+        }
         fit(&mut self.beta, n);
         for (b, w) in self.beta.iter_mut().zip(&self.u1) {
             *b = Rgb::splat(*w);
@@ -279,6 +304,7 @@ impl Wavefront {
         let has_lights = !scene.lights.is_empty();
         let has_area = scene.effects.contains(Effects::AREA_LIGHTS);
         let has_env = !scene.lights.environment().is_empty();
+        let camera_dims = CAMERA_DIMS + u32::from(scene.motion_blur());
         let mut depth = 0u32;
         while !self.live.is_empty() {
             self.trace_closest(scene);
@@ -290,7 +316,7 @@ impl Wavefront {
                 break;
             }
             let n = self.sort_by_material(scene);
-            let base = CAMERA_DIMS + depth * BOUNCE_DIMS;
+            let base = camera_dims + depth * BOUNCE_DIMS;
             if has_lights {
                 self.sample_lights(scene, n, base);
             }
@@ -304,9 +330,10 @@ impl Wavefront {
     }
 
     fn trace_closest(&mut self, scene: &RenderScene) {
+        let times = scene.motion_blur().then_some(&self.time[..]);
         scene
             .accel
-            .intersect_slots(&self.live, &self.origin, &self.dir, None, &mut self.hit);
+            .intersect_slots(&self.live, &self.origin, &self.dir, times, &mut self.hit);
         self.rays += self.live.len() as u64;
     }
 
@@ -323,6 +350,8 @@ impl Wavefront {
         let (next, emitting) = (&mut self.next_live[..], &mut self.em_slots[..]);
         let escaped = &mut self.esc_slots[..];
         let emitter = &scene.surfaces.emitter[..];
+        let time = &self.time[..];
+        let blur = scene.motion_blur();
         let (mut m, mut em, mut esc) = (0, 0, 0);
         for &slot in live {
             let i = slot as usize;
@@ -334,7 +363,8 @@ impl Wavefront {
                 }
                 continue;
             }
-            its[i] = interaction(scene, &hit, origin[i], dir[i], 0.0);
+            let tau = if blur { time[i] } else { 0.0 };
+            its[i] = interaction(scene, &hit, origin[i], dir[i], tau);
             if has_area && emitter[hit.prim as usize] != NO_EMITTER {
                 emitting[em] = slot;
                 em += 1;
@@ -417,7 +447,6 @@ impl Wavefront {
 
     /// Sorts live paths by material and gathers their shading inputs.
     fn sort_by_material(&mut self, scene: &RenderScene) -> usize {
-        let surfaces = &scene.surfaces;
         let hits = &self.hit;
         sort_by_key(
             &mut self.live,
@@ -425,7 +454,7 @@ impl Wavefront {
             &mut self.cursor,
             &mut self.offsets,
             scene.shaders.len(),
-            |slot| surfaces.material[hits[slot as usize].prim as usize],
+            |slot| scene.material(&hits[slot as usize]),
         );
         let n = self.live.len();
         fit(&mut self.ids_k, n);
@@ -622,10 +651,19 @@ impl Wavefront {
         self.shadow_dir.truncate(m);
         self.shadow_value.truncate(m);
         fit(&mut self.shadow_blocked, self.shadow_slot.len());
+        let times = if scene.motion_blur() {
+            self.shadow_time.clear();
+            let time = &self.time;
+            self.shadow_time
+                .extend(self.shadow_slot.iter().map(|&s| time[s as usize]));
+            Some(&self.shadow_time[..])
+        } else {
+            None
+        };
         scene.accel.occluded_each(
             &self.shadow_origin,
             &self.shadow_dir,
-            None,
+            times,
             1.0 - SHADOW_EPSILON,
             &mut self.shadow_blocked,
         );

@@ -23,19 +23,27 @@
 //! Every error names the file, line and column, what was expected and what
 //! is allowed. Relative paths are resolved against the scene file's folder.
 
+mod instances;
+mod keyframes;
 pub mod obj;
 pub mod transform;
 mod yaml;
 
 pub use crate::error::SceneError;
 pub use crate::settings::{FilterSampling, LightSelection, MAX_FILM_SIZE, RenderSettings};
+pub use crate::world::{Scene, Timeline};
+pub use instances::MAX_INSTANCES;
 
 use crate::world::{
-    CameraPose, EmitterSpec, FlippedNormals, Geometry, LightSpec, MaterialRef, ModuleSpec, Name,
-    Transform,
+    Animation, BaseTransform, CameraAnimation, CameraMotion, CameraPose, ClosingMesh, EmitterSpec,
+    FlippedNormals, Geometry, Instances, LightSpec, MaterialRef, MeshSequence, ModuleSpec, Name,
+    Pose, Track, Transform, TransformTracks,
 };
 use glam::{DMat4, DVec3};
-use hecs::World;
+use hecs::{EntityBuilder, World};
+use keyframes::KeyframeReader;
+use marked_yaml::Node;
+use radiant_core::params::Location;
 use radiant_core::{Numbers, Params};
 use serde::Deserialize;
 use std::collections::HashMap;
@@ -43,27 +51,6 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 pub(crate) use yaml::module_spec;
 use yaml::{Mapping, closest, loc, parse_node};
-
-/// A loaded scene: the world plus the settings and module definitions that
-/// are not entities.
-pub struct Scene {
-    /// The scene file.
-    pub file: PathBuf,
-    /// The folder relative paths are resolved against.
-    pub dir: PathBuf,
-    /// Shapes, lights and the camera.
-    pub world: World,
-    /// Integrator, film and sampler settings.
-    pub settings: RenderSettings,
-    /// The pixel filter.
-    pub filter: ModuleSpec,
-    /// The sampler.
-    pub sampler: ModuleSpec,
-    /// Named textures, in file order.
-    pub textures: Vec<(String, ModuleSpec)>,
-    /// Materials (shaders), indexed by [`MaterialRef`].
-    pub materials: Vec<(String, ModuleSpec)>,
-}
 
 const TOP_KEYS: &[&str] = &[
     "integrator",
@@ -74,6 +61,7 @@ const TOP_KEYS: &[&str] = &[
     "materials",
     "shapes",
     "lights",
+    "animation",
 ];
 const SHAPE_TYPES: &[&str] = &["rectangle", "cube", "sphere", "mesh"];
 const INTEGRATORS: &[&str] = &["path"];
@@ -87,6 +75,18 @@ pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
     from_str(&text, path, &dir)
 }
 
+/// What the loader keeps while it reads one scene file.
+struct Loader<'f> {
+    file: &'f Path,
+    dir: &'f Path,
+    keyframes: KeyframeReader<'f>,
+    materials: Vec<(String, ModuleSpec)>,
+    material_ids: HashMap<String, u32>,
+    /// Deforming meshes whose first frame is read once the frame range is
+    /// known: (entity, pattern, where `filename` was written).
+    sequences: Vec<(hecs::Entity, PathBuf, Option<Location>)>,
+}
+
 /// Parses scene text; `file` names it in errors and `dir` resolves
 /// relative paths.
 pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError> {
@@ -97,17 +97,32 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
     let (max_depth, rr_depth, light_selection) = parse_integrator(file, top.get("integrator"))?;
     let (film, filter) = parse_film(file, top.get("film"))?;
     let (spp, sampler) = parse_sampler(file, top.get("sampler"))?;
+    let (fps, frames) = parse_animation(file, top.get("animation"))?;
 
-    let camera_node = top.require("camera")?;
-    world.spawn((parse_camera(file, camera_node)?,));
-
-    let textures = named_modules(file, top.get("textures"), "texture")?;
-    let mut materials = named_modules(file, top.get("materials"), "material")?;
-    let mut material_ids: HashMap<String, u32> = materials
+    let mut loader = Loader {
+        file,
+        dir,
+        keyframes: KeyframeReader::new(file, fps),
+        materials: named_modules(file, top.get("materials"), "material")?,
+        material_ids: HashMap::new(),
+        sequences: Vec::new(),
+    };
+    loader.material_ids = loader
+        .materials
         .iter()
         .enumerate()
         .map(|(i, (name, _))| (name.clone(), i as u32))
         .collect();
+    for (_, spec) in &mut loader.materials {
+        loader.keyframes.module_tracks(spec)?;
+    }
+    let mut textures = named_modules(file, top.get("textures"), "texture")?;
+    for (_, spec) in &mut textures {
+        loader.keyframes.module_tracks(spec)?;
+    }
+
+    let camera_node = top.require("camera")?;
+    let shutter = loader.camera(&mut world, camera_node)?;
 
     if let Some(shapes) = top.get("shapes") {
         let seq = shapes.as_sequence().ok_or_else(|| {
@@ -118,23 +133,7 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
             )
         })?;
         for (index, node) in seq.iter().enumerate() {
-            let shape = parse_shape(file, dir, node, index, &mut materials, &mut material_ids)?;
-            let entity = world.spawn((
-                shape.name,
-                Transform(shape.transform),
-                shape.geometry,
-                shape.material,
-            ));
-            if shape.flip_normals {
-                world
-                    .insert_one(entity, FlippedNormals)
-                    .expect("entity was just spawned");
-            }
-            if let Some(emitter) = shape.emitter {
-                world
-                    .insert_one(entity, EmitterSpec(emitter))
-                    .expect("entity was just spawned");
-            }
+            loader.shape(&mut world, node, index)?;
         }
     }
 
@@ -147,17 +146,26 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
             )
         })?;
         for node in seq.iter() {
-            let spec = LightSpec(module_spec(file, node, "light", &["transform"])?);
-            let transform = match node.as_mapping().and_then(|m| m.get_node("transform")) {
-                Some(t) => transform::parse_transform(file, t)?,
-                None => DMat4::IDENTITY,
-            };
-            world.spawn((spec, Transform(transform)));
+            loader.light(&mut world, node)?;
         }
     }
     top.finish(TOP_KEYS)?;
+    loader.keyframes.check_all_read(&doc)?;
 
-    Ok(Scene {
+    // Without a frame range, the frames span the keys (or are frame 1).
+    let (start, end) = frames.unwrap_or_else(|| match loader.keyframes.key_span() {
+        Some((lo, hi)) => (lo.floor() as i64, hi.ceil() as i64),
+        None => (1, 1),
+    });
+    let timeline = Timeline {
+        fps,
+        start,
+        end,
+        shutter,
+    };
+    loader.read_sequences(&mut world, &timeline)?;
+
+    let mut scene = Scene {
         file: file.to_path_buf(),
         dir: dir.to_path_buf(),
         world,
@@ -171,11 +179,312 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
             light_selection,
             filter_sampling: film.filter_sampling,
         },
+        timeline,
+        frame: timeline.start,
         filter,
         sampler,
         textures,
-        materials,
-    })
+        materials: loader.materials,
+    };
+    crate::world::systems::animate(&mut scene, timeline.start)?;
+    Ok(scene)
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AnimationKeys {
+    #[serde(default = "default_fps")]
+    fps: f64,
+    #[serde(default)]
+    frames: Option<[i64; 2]>,
+}
+
+fn default_fps() -> f64 {
+    24.0
+}
+
+/// The scene's `animation: {fps, frames: [first, last]}`.
+fn parse_animation(
+    file: &Path,
+    node: Option<&Node>,
+) -> Result<(f64, Option<(i64, i64)>), SceneError> {
+    let Some(node) = node else {
+        return Ok((default_fps(), None));
+    };
+    let a: AnimationKeys = parse_node(file, node)?;
+    let at = |key: &str| {
+        node.as_mapping()
+            .and_then(|m| m.get_node(key))
+            .map_or_else(|| loc(node.span()), |n| loc(n.span()))
+    };
+    if !(a.fps > 0.0 && a.fps.is_finite()) {
+        return Err(SceneError::new(
+            file,
+            at("fps"),
+            format!("fps must be a positive number, found {}", a.fps),
+        ));
+    }
+    if let Some([first, last]) = a.frames
+        && (last < first || (last - first) >= 1 << 30)
+    {
+        return Err(SceneError::new(
+            file,
+            at("frames"),
+            format!("frames is [first, last] with first ≤ last, found [{first}, {last}]"),
+        ));
+    }
+    Ok((a.fps, a.frames.map(|[a, b]| (a, b))))
+}
+
+impl Loader<'_> {
+    /// Gives `entity` its transform: a fixed `transform`, or one animated
+    /// by `animation:` tracks after it.
+    fn placement(
+        &mut self,
+        world: &mut World,
+        entity: hecs::Entity,
+        transform: DMat4,
+        animation: Option<&Node>,
+    ) -> Result<(), SceneError> {
+        let tracks = match animation {
+            Some(n) => self.keyframes.transform_tracks(n)?,
+            None => TransformTracks::default(),
+        };
+        let pose = tracks.at(0.0);
+        let spawned = "the entity was just spawned";
+        world
+            .insert_one(entity, Transform(pose.matrix() * transform))
+            .expect(spawned);
+        if !tracks.is_constant() {
+            world
+                .insert(
+                    entity,
+                    (BaseTransform(transform), Animation(tracks), Pose::default()),
+                )
+                .expect(spawned);
+        }
+        Ok(())
+    }
+
+    /// Spawns the camera; returns the shutter.
+    fn camera(&mut self, world: &mut World, node: &Node) -> Result<Option<(f64, f64)>, SceneError> {
+        let file = self.file;
+        let mut module = module_spec(
+            file,
+            node,
+            "camera",
+            &["look_at", "transform", "animation", "shutter"],
+        )?;
+        self.keyframes.module_tracks(&mut module)?;
+        let map = node.as_mapping().expect("module_spec checked the mapping");
+        let (look, transform, animation) = (
+            map.get_node("look_at"),
+            map.get_node("transform"),
+            map.get_node("animation"),
+        );
+        let shutter = map
+            .get_node("shutter")
+            .map(|n| parse_shutter(file, n))
+            .transpose()?;
+        let mut entity = EntityBuilder::new();
+        let animated = match (look, transform) {
+            (Some(_), Some(t)) => {
+                return Err(SceneError::new(
+                    file,
+                    loc(t.span()),
+                    "give the camera either `look_at` or `transform`, not both",
+                ));
+            }
+            (Some(l), None) => {
+                if let Some(a) = animation {
+                    return Err(SceneError::new(
+                        file,
+                        loc(a.span()),
+                        "a camera with `look_at` moves by keyframes on its points; `animation:` \
+                         tracks go with a `transform`",
+                    ));
+                }
+                self.look_at(l)?
+            }
+            (None, t) => {
+                let base = match t {
+                    Some(t) => transform::parse_transform(file, t)?,
+                    None => DMat4::IDENTITY,
+                };
+                let tracks = match animation {
+                    Some(a) => self.keyframes.transform_tracks(a)?,
+                    None => TransformTracks::default(),
+                };
+                CameraAnimation::Tracks { base, tracks }
+            }
+        };
+        let to_world = match &animated {
+            CameraAnimation::Tracks { base, tracks } => tracks.at(0.0).matrix() * *base,
+            CameraAnimation::LookAt { origin, target, up } => {
+                crate::world::systems::look_at(origin.at(0.0), target.at(0.0), up.at(0.0))
+                    .unwrap_or(DMat4::IDENTITY)
+            }
+        };
+        let still = match &animated {
+            CameraAnimation::Tracks { tracks, .. } => tracks.is_constant(),
+            CameraAnimation::LookAt { origin, target, up } => {
+                origin.is_constant() && target.is_constant() && up.is_constant()
+            }
+        };
+        entity.add(CameraPose { to_world, module });
+        if !still {
+            entity.add_bundle((
+                animated,
+                CameraMotion {
+                    open: to_world,
+                    close: to_world,
+                },
+            ));
+        }
+        world.spawn(entity.build());
+        Ok(shutter)
+    }
+
+    /// A camera's `look_at`, whose points may have keyframes.
+    fn look_at(&mut self, node: &Node) -> Result<CameraAnimation, SceneError> {
+        let file = self.file;
+        let mut map = Mapping::new(file, node, "look_at")?;
+        let (origin, target) = (map.require("origin")?, map.require("target")?);
+        let up = map.get("up");
+        map.finish(&["origin", "target", "up"])?;
+        let mut point = |n: &Node| keyframes::point(file, n);
+        let origin = self.keyframes.value_or_track(origin, &mut point)?;
+        let target = self.keyframes.value_or_track(target, &mut point)?;
+        let up = match up {
+            Some(n) => self.keyframes.value_or_track(n, &mut point)?,
+            None => Track::constant(DVec3::Y),
+        };
+        // Every key must give a pose; in between, the system keeps the
+        // last good one.
+        let times = origin
+            .keys()
+            .iter()
+            .chain(target.keys())
+            .chain(up.keys())
+            .map(|k| k.time);
+        for t in times {
+            if crate::world::systems::look_at(origin.at(t), target.at(t), up.at(t)).is_none() {
+                return Err(SceneError::new(
+                    file,
+                    loc(node.span()),
+                    format!(
+                        "look_at needs a target different from the origin and an `up` not parallel to the view direction (at time {t} s)"
+                    ),
+                ));
+            }
+        }
+        Ok(CameraAnimation::LookAt { origin, target, up })
+    }
+
+    /// Spawns a light of `lights:`.
+    fn light(&mut self, world: &mut World, node: &Node) -> Result<(), SceneError> {
+        let file = self.file;
+        let mut spec = module_spec(file, node, "light", &["transform", "animation"])?;
+        self.keyframes.module_tracks(&mut spec)?;
+        let map = node.as_mapping().expect("module_spec checked the mapping");
+        let transform = match map.get_node("transform") {
+            Some(t) => transform::parse_transform(file, t)?,
+            None => DMat4::IDENTITY,
+        };
+        let entity = world.spawn((LightSpec(spec),));
+        self.placement(world, entity, transform, map.get_node("animation"))
+    }
+
+    /// Spawns shape `index` of `shapes:`.
+    fn shape(&mut self, world: &mut World, node: &Node, index: usize) -> Result<(), SceneError> {
+        let file = self.file;
+        let shape = parse_shape(self, node, index)?;
+        // Spawned and given its components in this order, so that the
+        // world iterates shapes as it always has (hecs groups entities by
+        // their set of components, in the order the sets first appear).
+        let entity = world.spawn((
+            shape.name,
+            Transform(shape.transform),
+            shape.geometry,
+            shape.material,
+        ));
+        let spawned = "the entity was just spawned";
+        let map = node.as_mapping().expect("parse_shape checked the mapping");
+        if shape.flip_normals {
+            world.insert_one(entity, FlippedNormals).expect(spawned);
+        }
+        let emitter_node = map.get_node("emitter");
+        if let Some(mut emitter) = shape.emitter {
+            self.keyframes.module_tracks(&mut emitter)?;
+            world
+                .insert_one(entity, EmitterSpec(emitter))
+                .expect(spawned);
+        }
+        self.placement(world, entity, shape.transform, map.get_node("animation"))?;
+        if let Some(n) = map.get_node("instances") {
+            if let Some(e) = emitter_node {
+                return Err(SceneError::new(
+                    file,
+                    loc(e.span()),
+                    "an instanced shape cannot carry an `emitter`: give each glowing copy a shape of its own",
+                ));
+            }
+            let list = instances::parse_instances(file, n, &mut |m| {
+                parse_material_ref(self, Some(m), "an instance")
+            })?;
+            if matches!(shape.sphere, true) && list.iter().any(|i| !is_similarity(i.transform)) {
+                return Err(SceneError::new(
+                    file,
+                    loc(n.span()),
+                    "a sphere's instances may only rotate, translate and scale uniformly",
+                ));
+            }
+            world
+                .insert_one(entity, Instances(Arc::from(list)))
+                .expect(spawned);
+        }
+        if let Some((pattern, at)) = shape.sequence {
+            self.sequences.push((entity, pattern, at));
+        }
+        Ok(())
+    }
+
+    /// Reads the first frame of every deforming mesh.
+    fn read_sequences(&mut self, world: &mut World, timeline: &Timeline) -> Result<(), SceneError> {
+        for (entity, pattern, at) in self.sequences.drain(..) {
+            let path = crate::world::systems::sequence_path(&pattern, timeline.start);
+            let first =
+                obj::load_obj_frame(&path).map_err(|m| SceneError::new(self.file, at, m))?;
+            let first = Arc::new(first);
+            let sequence = MeshSequence {
+                pattern,
+                location: at,
+                topology: first.clone(),
+            };
+            world
+                .insert(
+                    entity,
+                    (sequence, Geometry::Mesh(first.clone()), ClosingMesh(first)),
+                )
+                .expect("the shape was spawned");
+        }
+        Ok(())
+    }
+}
+
+/// A camera's `shutter: [open, close]`, in frames after the frame's time.
+fn parse_shutter(file: &Path, node: &Node) -> Result<(f64, f64), SceneError> {
+    let [open, close] = parse_node::<Numbers<2>>(file, node)?.0;
+    if !(open < close && (close - open) <= 1e6) {
+        return Err(SceneError::new(
+            file,
+            loc(node.span()),
+            format!(
+                "shutter is [open, close] in frames after the frame's time, with open < close (e.g. [0, 0.5], or [-0.25, 0.25] centred); found [{open}, {close}]"
+            ),
+        ));
+    }
+    Ok((open, close))
 }
 
 #[derive(Deserialize)]
@@ -246,13 +555,13 @@ fn default_height() -> u32 {
 
 /// A module of type `type_name` with no parameters (its defaults).
 pub(crate) fn default_module(type_name: &str) -> ModuleSpec {
-    ModuleSpec {
-        type_name: type_name.to_string(),
-        location: None,
-        params: Params::new(marked_yaml::Node::Mapping(
+    ModuleSpec::new(
+        type_name.to_string(),
+        None,
+        Params::new(marked_yaml::Node::Mapping(
             marked_yaml::types::MarkedMappingNode::new_empty(marked_yaml::Span::new_blank()),
         )),
-    }
+    )
 }
 
 fn parse_film(
@@ -335,24 +644,6 @@ fn parse_sampler(
     Ok((p.spp, spec))
 }
 
-fn parse_camera(file: &Path, node: &marked_yaml::Node) -> Result<CameraPose, SceneError> {
-    let module = module_spec(file, node, "camera", &["look_at", "transform"])?;
-    let map = node.as_mapping().expect("module_spec checked the mapping");
-    let to_world = match (map.get_node("look_at"), map.get_node("transform")) {
-        (Some(_), Some(t)) => {
-            return Err(SceneError::new(
-                file,
-                loc(t.span()),
-                "give the camera either `look_at` or `transform`, not both",
-            ));
-        }
-        (Some(l), None) => transform::parse_look_at(file, l)?,
-        (None, Some(t)) => transform::parse_transform(file, t)?,
-        (None, None) => DMat4::IDENTITY,
-    };
-    Ok(CameraPose { to_world, module })
-}
-
 fn named_modules(
     file: &Path,
     node: Option<&marked_yaml::Node>,
@@ -400,6 +691,11 @@ struct ShapeDef {
     material: MaterialRef,
     emitter: Option<ModuleSpec>,
     flip_normals: bool,
+    /// Whether the shape is a sphere.
+    sphere: bool,
+    /// For a deforming mesh: its file name pattern (resolved) and where
+    /// it was written.
+    sequence: Option<(PathBuf, Option<Location>)>,
 }
 
 #[derive(Deserialize)]
@@ -415,14 +711,8 @@ fn one() -> f64 {
     1.0
 }
 
-fn parse_shape(
-    file: &Path,
-    dir: &Path,
-    node: &marked_yaml::Node,
-    index: usize,
-    materials: &mut Vec<(String, ModuleSpec)>,
-    material_ids: &mut HashMap<String, u32>,
-) -> Result<ShapeDef, SceneError> {
+fn parse_shape(loader: &mut Loader<'_>, node: &Node, index: usize) -> Result<ShapeDef, SceneError> {
+    let (file, dir) = (loader.file, loader.dir);
     let mut map = Mapping::new(file, node, "shape")?;
     let (type_name, type_loc) = map.string("type")?.ok_or_else(|| {
         SceneError::new(
@@ -445,7 +735,7 @@ fn parse_shape(
         .get("emitter")
         .map(|e| module_spec(file, e, "emitter", &[]))
         .transpose()?;
-    let material = parse_material_ref(file, map.get("material"), &name, materials, material_ids)?;
+    let material = parse_material_ref(loader, map.get("material"), &name)?;
     let flip_node = map.get("flip_normals");
     let flip_normals = match flip_node {
         Some(node) => match node.as_scalar().and_then(|s| s.as_bool()) {
@@ -460,7 +750,11 @@ fn parse_shape(
         },
         None => false,
     };
+    // Read by the loader itself.
+    map.get("animation");
+    map.get("instances");
 
+    let mut sequence = None;
     let (geometry, allowed): (Geometry, &[&str]) = match type_name.as_str() {
         "rectangle" => (Geometry::Rectangle, &[]),
         "cube" => (Geometry::Cube, &[]),
@@ -471,7 +765,7 @@ fn parse_shape(
                     keys.insert(key.into(), v.clone());
                 }
             }
-            let s: SphereKeys = parse_node(file, &marked_yaml::Node::Mapping(keys))?;
+            let s: SphereKeys = parse_node(file, &Node::Mapping(keys))?;
             if !(s.radius > 0.0 && s.radius.is_finite()) {
                 return Err(SceneError::new(
                     file,
@@ -499,9 +793,16 @@ fn parse_shape(
                     ));
                 }
             };
-            let mesh = obj::load_obj(&dir.join(&filename))
-                .map_err(|msg| SceneError::new(file, file_loc, msg))?;
-            (Geometry::Mesh(Arc::new(mesh)), &["filename"])
+            if filename.contains('#') {
+                // A deforming mesh: its frames are read once the frame
+                // range is known; until then, an empty mesh.
+                sequence = Some((dir.join(&filename), file_loc));
+                (Geometry::Mesh(Arc::default()), &["filename"])
+            } else {
+                let mesh = obj::load_obj(&dir.join(&filename))
+                    .map_err(|msg| SceneError::new(file, file_loc, msg))?;
+                (Geometry::Mesh(Arc::new(mesh)), &["filename"])
+            }
         }
         other => {
             let hint = closest(other, SHAPE_TYPES)
@@ -524,17 +825,20 @@ fn parse_shape(
         "emitter",
         "material",
         "flip_normals",
+        "animation",
+        "instances",
     ];
     keys.extend_from_slice(allowed);
     map.finish(&keys)?;
-    if let (Geometry::Sphere, true, Some(node)) = (&geometry, flip_normals, flip_node) {
+    let sphere = matches!(geometry, Geometry::Sphere);
+    if let (true, true, Some(node)) = (sphere, flip_normals, flip_node) {
         return Err(SceneError::new(
             file,
             loc(node.span()),
             "`flip_normals` is not supported on spheres; use a cube or a mesh for an inward-facing enclosure",
         ));
     }
-    if matches!(geometry, Geometry::Sphere) && !is_similarity(transform) {
+    if sphere && !is_similarity(transform) {
         return Err(SceneError::new(
             file,
             type_loc,
@@ -548,6 +852,8 @@ fn parse_shape(
         material,
         emitter,
         flip_normals,
+        sphere,
+        sequence,
     })
 }
 
@@ -567,12 +873,12 @@ fn is_similarity(m: DMat4) -> bool {
 }
 
 fn parse_material_ref(
-    file: &Path,
-    node: Option<&marked_yaml::Node>,
+    loader: &mut Loader<'_>,
+    node: Option<&Node>,
     shape_name: &str,
-    materials: &mut Vec<(String, ModuleSpec)>,
-    material_ids: &mut HashMap<String, u32>,
 ) -> Result<MaterialRef, SceneError> {
+    let file = loader.file;
+    let (materials, material_ids) = (&mut loader.materials, &mut loader.material_ids);
     match node {
         None => {
             // Mitsuba's default: a 50% grey diffuse surface.
@@ -606,9 +912,12 @@ fn parse_material_ref(
             })
         }
         Some(n) => {
-            let spec = module_spec(file, n, "material", &[])?;
-            materials.push((format!("<material of {shape_name}>"), spec));
-            Ok(MaterialRef(materials.len() as u32 - 1))
+            let mut spec = module_spec(file, n, "material", &[])?;
+            loader.keyframes.module_tracks(&mut spec)?;
+            loader
+                .materials
+                .push((format!("<material of {shape_name}>"), spec));
+            Ok(MaterialRef(loader.materials.len() as u32 - 1))
         }
     }
 }

@@ -15,6 +15,69 @@ use std::path::Path;
 
 /// Loads every object of an OBJ file into one mesh (materials are ignored).
 pub fn load_obj(path: &Path) -> Result<MeshData, String> {
+    let mut mesh = read_obj(path)?;
+    repair(&mut mesh);
+    if mesh.triangles.is_empty() {
+        return Err(format!(
+            "mesh file `{}` has no usable triangles ({} dropped as degenerate, {} for non-finite coordinates)",
+            path.display(),
+            mesh.repairs.degenerate,
+            mesh.repairs.non_finite
+        ));
+    }
+    Ok(mesh)
+}
+
+/// Loads one frame of a deforming mesh: as [`load_obj`], but every
+/// triangle is kept, degenerate or not, so that all frames of a sequence
+/// have the same triangles (a triangle of zero area is never hit, one
+/// with non-finite vertices neither).
+pub fn load_obj_frame(path: &Path) -> Result<MeshData, String> {
+    let mut mesh = read_obj(path)?;
+    repair_attributes(&mut mesh);
+    if mesh.triangles.is_empty() {
+        return Err(format!("mesh file `{}` has no triangles", path.display()));
+    }
+    Ok(mesh)
+}
+
+/// Checks that `mesh`, a frame of a deforming mesh, has the triangles of
+/// the sequence's first frame `first`.
+pub fn check_topology(first: &MeshData, mesh: &MeshData) -> Result<(), String> {
+    let counts = |m: &MeshData| (m.triangles.len(), m.positions.len());
+    if counts(first) != counts(mesh) {
+        return Err(format!(
+            "`{}` has {} triangles and {} vertices, but the sequence's first frame `{}` has {} and {}: \
+             every frame of a deforming mesh needs the same triangles",
+            mesh.source,
+            mesh.triangles.len(),
+            mesh.positions.len(),
+            first.source,
+            first.triangles.len(),
+            first.positions.len()
+        ));
+    }
+    if let Some(i) = (0..first.triangles.len()).find(|&i| first.triangles[i] != mesh.triangles[i]) {
+        return Err(format!(
+            "`{}` has the vertex and triangle counts of the sequence's first frame `{}`, but triangle {} \
+             joins other vertices: every frame of a deforming mesh needs the same triangles",
+            mesh.source,
+            first.source,
+            i + 1
+        ));
+    }
+    let attributes = |m: &MeshData| (m.normals.is_some(), m.uvs.is_some());
+    if attributes(first) != attributes(mesh) {
+        return Err(format!(
+            "`{}` and the sequence's first frame `{}` differ in whether they have vertex normals or texture coordinates",
+            mesh.source, first.source
+        ));
+    }
+    Ok(())
+}
+
+/// Reads every object of an OBJ file into one mesh, unrepaired.
+fn read_obj(path: &Path) -> Result<MeshData, String> {
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -75,15 +138,6 @@ pub fn load_obj(path: &Path) -> Result<MeshData, String> {
     if all_have_uvs && uvs.len() == n_vertices {
         mesh.uvs = Some(uvs);
     }
-    repair(&mut mesh);
-    if mesh.triangles.is_empty() {
-        return Err(format!(
-            "mesh file `{}` has no usable triangles ({} dropped as degenerate, {} for non-finite coordinates)",
-            path.display(),
-            mesh.repairs.degenerate,
-            mesh.repairs.non_finite
-        ));
-    }
     Ok(mesh)
 }
 
@@ -103,6 +157,14 @@ pub fn repair(mesh: &mut MeshData) {
         }
         true
     });
+    mesh.repairs = repairs;
+    repair_attributes(mesh);
+}
+
+/// Marks unusable normals (as zero vectors, so the face normal is used)
+/// and sets non-finite texture coordinates to (0, 0).
+fn repair_attributes(mesh: &mut MeshData) {
+    let mut repairs = mesh.repairs;
     if let Some(normals) = &mut mesh.normals {
         for n in normals.iter_mut() {
             match n.try_normalize() {

@@ -261,9 +261,9 @@ pub(crate) fn module_spec(
             rest.insert(k.clone(), v.clone());
         }
     }
-    Ok(ModuleSpec {
+    Ok(ModuleSpec::new(
         type_name,
-        location: loc(type_node.span()),
-        params: Params::new(Node::Mapping(rest)),
-    })
+        loc(type_node.span()),
+        Params::new(Node::Mapping(rest)),
+    ))
 }

@@ -1,17 +1,82 @@
 //! Component types of the scene world.
 
-use glam::{DMat4, Vec2, Vec3};
+use super::animation::{Track, TransformTracks, Trs};
+use glam::{DMat4, DVec3, Vec2, Vec3};
+use marked_yaml::Span;
 use radiant_core::Params;
 use radiant_core::params::Location;
+use std::path::PathBuf;
 use std::sync::Arc;
 
 /// The name a scene gave an entity.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Name(pub String);
 
-/// Object-to-world transform, in double precision.
+/// Object-to-world transform at the current frame, in double precision
+/// (the animation system writes it for animated entities).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Transform(pub DMat4);
+
+/// The part of an animated entity's transform that does not move: its
+/// `transform:` as written, applied before the animated pose.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BaseTransform(pub DMat4);
+
+/// The translation, rotation and scale tracks of a shape or light
+/// (`animation:`); its [`Transform`] is pose(t) · [`BaseTransform`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Animation(pub TransformTracks);
+
+/// Where the animation system put an animated entity for the current
+/// frame: its pose at the frame's time, and at shutter open and close
+/// where it moves while the shutter is open.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pose {
+    /// The pose at the frame's time.
+    pub frame: Trs,
+    /// The poses at shutter open and close, where they differ.
+    pub shutter: Option<(Trs, Trs)>,
+}
+
+/// One step of the path from a module's parameters to an animated value.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ParamStep {
+    /// The value of a mapping's key.
+    Key(String),
+    /// An element of a list.
+    Index(usize),
+}
+
+/// A module parameter given as `keyframes:`: where it is in the
+/// parameters, and its track.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamTrack {
+    /// The path from the parameters' mapping to the value.
+    pub path: Vec<ParamStep>,
+    /// Values over time: one number, or a list of numbers.
+    pub track: Track<Vec<f64>>,
+    /// Whether the value is one number (else a list).
+    pub scalar: bool,
+    /// Where the `keyframes` mapping was written (errors about the value
+    /// point here).
+    pub span: Span,
+}
+
+impl ParamTrack {
+    /// The YAML node that holds `value` (one number, or a list).
+    pub fn node(&self, value: &[f64]) -> marked_yaml::Node {
+        use marked_yaml::Node;
+        use marked_yaml::types::{MarkedScalarNode, MarkedSequenceNode};
+        // `{:?}` prints the shortest text that reads back as the same f64.
+        let scalar = |v: f64| Node::Scalar(MarkedScalarNode::new(self.span, format!("{v:?}")));
+        if self.scalar {
+            scalar(value[0])
+        } else {
+            let items = value.iter().map(|&v| scalar(v)).collect();
+            Node::Sequence(MarkedSequenceNode::new(self.span, items))
+        }
+    }
+}
 
 /// A module instance as written in the scene: its `type` and parameters.
 #[derive(Debug, Clone)]
@@ -20,8 +85,27 @@ pub struct ModuleSpec {
     pub type_name: String,
     /// Where the `type` was written.
     pub location: Option<Location>,
-    /// The remaining keys, for the module to parse.
+    /// The remaining keys, for the module to parse; animated values hold
+    /// their value at the current frame.
     pub params: Params,
+    /// The animated parameters.
+    pub tracks: Vec<ParamTrack>,
+    /// Counts the changes of the parameters' values: extract rebuilds the
+    /// module when it moves on.
+    pub revision: u64,
+}
+
+impl ModuleSpec {
+    /// A module spec with fixed parameters.
+    pub fn new(type_name: String, location: Option<Location>, params: Params) -> Self {
+        Self {
+            type_name,
+            location,
+            params,
+            tracks: Vec::new(),
+            revision: 0,
+        }
+    }
 }
 
 /// The shape of a surface entity (conventions of Mitsuba 3).
@@ -118,6 +202,38 @@ impl MeshRepairs {
     }
 }
 
+/// A mesh read from a numbered sequence of OBJ files, one per frame
+/// (`filename: sim/frame_####.obj`): its [`Geometry`] is the mesh at the
+/// current frame, every frame with the triangles of the first.
+#[derive(Debug, Clone)]
+pub struct MeshSequence {
+    /// The file name pattern as resolved against the scene's folder; the
+    /// run of `#` is the frame number, zero-padded to the run's length.
+    pub pattern: PathBuf,
+    /// Where `filename` was written.
+    pub location: Option<Location>,
+    /// The first frame's mesh: every frame must have its triangles.
+    pub topology: Arc<MeshData>,
+}
+
+/// The mesh of a deforming shape at shutter close, where the shutter is
+/// open (its [`Geometry`] then holds the mesh at shutter open).
+#[derive(Debug, Clone)]
+pub struct ClosingMesh(pub Arc<MeshData>);
+
+/// Copies of a shape (`instances:`), sharing its geometry.
+#[derive(Debug, Clone)]
+pub struct Instances(pub Arc<[InstanceSpec]>);
+
+/// One copy of an instanced shape.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InstanceSpec {
+    /// Applied after the shape's own transform.
+    pub transform: DMat4,
+    /// A material of its own, instead of the shape's.
+    pub material: Option<MaterialRef>,
+}
+
 /// A triangle mesh in object space.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct MeshData {
@@ -155,8 +271,41 @@ pub struct LightSpec(pub ModuleSpec);
 /// The camera's pose (camera to world) and module.
 #[derive(Debug, Clone)]
 pub struct CameraPose {
-    /// Camera space (+z forward, +y up, +x left) to world.
+    /// Camera space (+z forward, +y up, +x left) to world, at the current
+    /// frame.
     pub to_world: DMat4,
     /// The camera module.
     pub module: ModuleSpec,
+}
+
+/// How the camera moves: a `look_at` whose points have tracks, or a
+/// `transform` with `animation:` tracks.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CameraAnimation {
+    /// `look_at` with animated points.
+    LookAt {
+        /// The eye.
+        origin: Track<DVec3>,
+        /// The point looked at.
+        target: Track<DVec3>,
+        /// The up direction.
+        up: Track<DVec3>,
+    },
+    /// `animation:` tracks after the camera's `transform`.
+    Tracks {
+        /// The camera's `transform` (or the identity).
+        base: DMat4,
+        /// Its tracks.
+        tracks: TransformTracks,
+    },
+}
+
+/// The camera's pose at shutter open and close, where it moves while the
+/// shutter is open (the animation system writes it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraMotion {
+    /// Camera to world at shutter open.
+    pub open: DMat4,
+    /// Camera to world at shutter close.
+    pub close: DMat4,
 }

@@ -28,6 +28,9 @@ bitflags! {
         const TRANSMISSION = 1 << 7;
         /// A camera with a finite aperture.
         const DEPTH_OF_FIELD = 1 << 8;
+        /// Geometry or the camera moving while the shutter is open: rays
+        /// carry a time (set by the engine, not by modules).
+        const MOTION_BLUR = 1 << 9;
     }
 }
 

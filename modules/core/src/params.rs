@@ -105,6 +105,12 @@ impl Params {
         &self.node
     }
 
+    /// The YAML node of the parameters, to change values in place (the
+    /// engine writes animated values here before a module is rebuilt).
+    pub fn node_mut(&mut self) -> &mut Node {
+        &mut self.node
+    }
+
     /// Location of the value of `key`, or of the whole mapping if absent.
     pub fn location_of(&self, key: &str) -> Option<Location> {
         let map = self.node.as_mapping();

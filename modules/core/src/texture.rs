@@ -69,26 +69,72 @@ impl TextureRef {
 }
 
 /// All textures of a scene.
+///
+/// Entries are added while modules are built; when the engine rebuilds a
+/// module for a new frame (an animated parameter changed), it releases the
+/// entries the old instance added ([`TextureTable::take_added`],
+/// [`TextureTable::release`]) so that their slots are reused and the table
+/// does not grow from frame to frame.
 #[derive(Default)]
 pub struct TextureTable {
     entries: Vec<TextureRef>,
+    /// Released slots, reused first.
+    free: Vec<u32>,
+    /// Ids handed out since the last [`TextureTable::take_added`].
+    added: Vec<TextureId>,
 }
 
 impl TextureTable {
+    fn push(&mut self, entry: TextureRef) -> TextureId {
+        let id = match self.free.pop() {
+            Some(i) => {
+                self.entries[i as usize] = entry;
+                TextureId(i)
+            }
+            None => {
+                self.entries.push(entry);
+                TextureId(self.entries.len() as u32 - 1)
+            }
+        };
+        self.added.push(id);
+        id
+    }
+
+    fn entry(texture: Box<dyn Texture>) -> TextureRef {
+        match texture.constant() {
+            Some(c) => TextureRef::Constant(c),
+            None => TextureRef::Module(Arc::from(texture)),
+        }
+    }
+
     /// Adds an inline constant value and returns its id.
     pub fn add_constant(&mut self, value: Rgb) -> TextureId {
-        self.entries.push(TextureRef::Constant(value));
-        TextureId(self.entries.len() as u32 - 1)
+        self.push(TextureRef::Constant(value))
     }
 
     /// Adds a texture module instance and returns its id.
     pub fn add(&mut self, texture: Box<dyn Texture>) -> TextureId {
-        let entry = match texture.constant() {
-            Some(c) => TextureRef::Constant(c),
-            None => TextureRef::Module(Arc::from(texture)),
-        };
-        self.entries.push(entry);
-        TextureId(self.entries.len() as u32 - 1)
+        self.push(Self::entry(texture))
+    }
+
+    /// Puts `texture` in place of texture `id` (a named texture rebuilt for
+    /// a new frame keeps its id).
+    pub fn replace(&mut self, id: TextureId, texture: Box<dyn Texture>) {
+        self.entries[id.0 as usize] = Self::entry(texture);
+    }
+
+    /// The ids added since the last call (the entries a module added while
+    /// it was built).
+    pub fn take_added(&mut self) -> Vec<TextureId> {
+        std::mem::take(&mut self.added)
+    }
+
+    /// Frees the entries `ids` for reuse; nothing may read them afterwards.
+    pub fn release(&mut self, ids: &[TextureId]) {
+        for id in ids {
+            self.entries[id.0 as usize] = TextureRef::Constant(Rgb::ZERO);
+            self.free.push(id.0);
+        }
     }
 
     /// Evaluates texture `id` at every `uv[i]` into `out[i]`.
@@ -121,7 +167,7 @@ impl TextureTable {
         self.entries[id.0 as usize].effects()
     }
 
-    /// Number of textures, constants included.
+    /// Number of texture slots, constants and released ones included.
     pub fn len(&self) -> usize {
         self.entries.len()
     }
