@@ -47,7 +47,7 @@ fn cube(scale: f32, offset: Vec3) -> Vec<Primitive> {
 
 /// Hit point, error bound and geometric normal of a triangle hit.
 fn surface(accel: &Accel, hit: &Hit) -> (Vec3, Vec3, Vec3) {
-    let Primitive::Triangle(v) = accel.primitives()[hit.prim as usize] else {
+    let (Primitive::Triangle(v), None) = accel.primitive(hit, 0.0) else {
         panic!("expected a triangle")
     };
     let b0 = 1.0 - hit.b1 - hit.b2;

@@ -82,12 +82,13 @@ fn measure(name: &str, accel: &Accel, closest: &[Query], shadow: &[Query]) {
     let mut best = [f64::INFINITY; 2];
     for _ in 0..PASSES {
         let start = Instant::now();
-        accel.intersect_slots(&slots, black_box(&origins), &dirs, &mut hit);
+        accel.intersect_slots(&slots, black_box(&origins), &dirs, None, &mut hit);
         best[0] = best[0].min(start.elapsed().as_secs_f64());
         let start = Instant::now();
         accel.occluded_each(
             black_box(&shadow_origins),
             &shadow_dirs,
+            None,
             1.0,
             &mut is_blocked,
         );
@@ -98,7 +99,7 @@ fn measure(name: &str, accel: &Accel, closest: &[Query], shadow: &[Query]) {
     let ns = |s: f64, n: usize| s / n as f64 * 1e9;
     println!(
         "{name}: {} primitives, built in {:.1} ms",
-        accel.primitives().len(),
+        accel.blases().iter().map(|b| b.len()).sum::<usize>(),
         accel.build_time.as_secs_f64() * 1e3
     );
     println!(
@@ -135,7 +136,7 @@ fn cornell(rng: &mut Lcg, obj: Option<&Path>) -> Result<()> {
     let scene = radiant::scene::load(&path)?;
     let render = extract(&scene, &radiant::builtin_registry(), &Overrides::default())?;
     if let Some(obj) = obj {
-        write_obj(render.accel.primitives(), obj)?;
+        write_obj(render.accel.blases()[0].primitives(), obj)?;
     }
     let closest: Vec<Query> = (0..RAYS)
         .map(|_| {

@@ -115,6 +115,11 @@ impl Blas {
         &self.order
     }
 
+    /// The primitives in leaf order (at shutter open).
+    pub fn primitives(&self) -> &[Primitive] {
+        &self.prims
+    }
+
     /// Number of primitives.
     pub fn len(&self) -> usize {
         self.prims.len()

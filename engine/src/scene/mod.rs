@@ -352,11 +352,19 @@ impl Loader<'_> {
         let (origin, target) = (map.require("origin")?, map.require("target")?);
         let up = map.get("up");
         map.finish(&["origin", "target", "up"])?;
-        let mut point = |n: &Node| keyframes::point(file, n);
-        let origin = self.keyframes.value_or_track(origin, &mut point)?;
-        let target = self.keyframes.value_or_track(target, &mut point)?;
+        let mut reader = |key: &'static str, n: &Node, kf: &mut KeyframeReader<'_>| {
+            let mut point = |v: &Node| {
+                keyframes::point(file, v).map_err(|mut e| {
+                    e.message = format!("look_at `{key}`: {}", e.message);
+                    e
+                })
+            };
+            kf.value_or_track(n, &mut point)
+        };
+        let origin = reader("origin", origin, &mut self.keyframes)?;
+        let target = reader("target", target, &mut self.keyframes)?;
         let up = match up {
-            Some(n) => self.keyframes.value_or_track(n, &mut point)?,
+            Some(n) => reader("up", n, &mut self.keyframes)?,
             None => Track::constant(DVec3::Y),
         };
         // Every key must give a pose; in between, the system keeps the
