@@ -352,7 +352,7 @@ impl Loader<'_> {
         let (origin, target) = (map.require("origin")?, map.require("target")?);
         let up = map.get("up");
         map.finish(&["origin", "target", "up"])?;
-        let mut reader = |key: &'static str, n: &Node, kf: &mut KeyframeReader<'_>| {
+        let reader = |key: &'static str, n: &Node, kf: &mut KeyframeReader<'_>| {
             let mut point = |v: &Node| {
                 keyframes::point(file, v).map_err(|mut e| {
                     e.message = format!("look_at `{key}`: {}", e.message);

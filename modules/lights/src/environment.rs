@@ -26,6 +26,9 @@ use radiant_core::{
 };
 use serde::Deserialize;
 use std::f32::consts::{PI, TAU};
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex, Weak};
+use std::time::SystemTime;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -75,7 +78,63 @@ struct Map {
 #[derive(Debug, Clone, PartialEq)]
 enum Emission {
     Constant(Rgb),
-    Map(Map),
+    /// Shared with other instances of the same map (see [`MapCache`]).
+    Map(Arc<Map>),
+}
+
+/// The decoded maps and their distributions, kept while a light uses them:
+/// a light rebuilt for a new frame (the scene's bounds moved) finds the
+/// map its predecessor decoded instead of reading the file again. Keyed by
+/// the file (path, size, modification time) and the scale.
+struct MapCache {
+    entries: Mutex<Vec<(MapKey, Weak<Map>, f32)>>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+struct MapKey {
+    path: PathBuf,
+    len: u64,
+    modified: Option<SystemTime>,
+    scale: u32,
+}
+
+impl MapKey {
+    /// The key of the map file at `path` scaled by `scale`.
+    fn new(path: &std::path::Path, scale: f32) -> Self {
+        let meta = std::fs::metadata(path).ok();
+        MapKey {
+            path: path.canonicalize().unwrap_or_else(|_| path.to_path_buf()),
+            len: meta.as_ref().map_or(0, |m| m.len()),
+            modified: meta.and_then(|m| m.modified().ok()),
+            scale: scale.to_bits(),
+        }
+    }
+}
+
+static MAPS: MapCache = MapCache {
+    entries: Mutex::new(Vec::new()),
+};
+
+impl MapCache {
+    /// The map of `key` with its integral, made by `make` unless a live
+    /// light holds it already.
+    fn get(
+        &self,
+        key: MapKey,
+        make: impl FnOnce() -> Result<(Map, f32), String>,
+    ) -> Result<(Arc<Map>, f32), String> {
+        let mut entries = self.entries.lock().unwrap_or_else(|e| e.into_inner());
+        entries.retain(|(_, weak, _)| weak.strong_count() > 0);
+        if let Some((_, weak, integral)) = entries.iter().find(|(k, ..)| *k == key)
+            && let Some(map) = weak.upgrade()
+        {
+            return Ok((map, *integral));
+        }
+        let (map, integral) = make()?;
+        let map = Arc::new(map);
+        entries.push((key, Arc::downgrade(&map), integral));
+        Ok((map, integral))
+    }
 }
 
 /// Radiance from infinitely far away.
@@ -145,12 +204,12 @@ impl EnvironmentLight {
         let distribution = Distribution2D::new(&weights, UVec2::new(size.x, size.y - 1));
         let integral = (TAU / w as f32) * distribution.total() as f32;
         Ok(Self {
-            emission: Emission::Map(Map {
+            emission: Emission::Map(Arc::new(Map {
                 size,
                 texels: pixels,
                 cos_theta,
                 distribution,
-            }),
+            })),
             to_render,
             to_light: to_render.transpose(),
             sphere,
@@ -338,16 +397,79 @@ pub(crate) fn register(registry: &mut Registry) {
                         message,
                         location: params.location_of("filename"),
                     };
-                    let (mut pixels, size) = load_map(&ctx.scene_dir.join(&f)).map_err(at)?;
-                    for px in &mut pixels {
-                        *px *= p.scale;
+                    let path = ctx.scene_dir.join(&f);
+                    let (map, integral) = MAPS
+                        .get(MapKey::new(&path, p.scale), || {
+                            let (mut pixels, size) = load_map(&path)?;
+                            for px in &mut pixels {
+                                *px *= p.scale;
+                            }
+                            let light = EnvironmentLight::from_pixels(
+                                pixels,
+                                size,
+                                to_render,
+                                ctx.scene_sphere,
+                            )
+                            .map_err(|m| format!("{f}: {m}"))?;
+                            match light.emission {
+                                Emission::Map(m) => Ok((Arc::unwrap_or_clone(m), light.integral)),
+                                Emission::Constant(_) => unreachable!("from_pixels makes a map"),
+                            }
+                        })
+                        .map_err(at)?;
+                    EnvironmentLight {
+                        emission: Emission::Map(map),
+                        to_render,
+                        to_light: to_render.transpose(),
+                        sphere: ctx.scene_sphere,
+                        integral,
                     }
-                    EnvironmentLight::from_pixels(pixels, size, to_render, ctx.scene_sphere)
-                        .map_err(|m| at(format!("{f}: {m}")))?
                 }
             };
             Ok(Box::new(EnvironmentLight { to_render, to_light: to_render.transpose(), ..light })
                 as Box<dyn Light>)
         },
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use radiant_core::{BuildContext, TextureTable};
+    use std::collections::HashMap;
+    use std::path::Path;
+
+    /// Builds the scene's sky map light with a scene sphere of `radius`.
+    fn sky(registry: &Registry, radius: f32) -> Box<dyn Light> {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+        let mut textures = TextureTable::default();
+        let named = HashMap::new();
+        let mut ctx = BuildContext::standalone(&dir, &mut textures, &named);
+        ctx.scene_sphere.radius = radius;
+        let params =
+            Params::from_yaml("{filename: environment-sky.exr, scale: 2}").expect("valid YAML");
+        // `expect` is the assertion: the committed map builds.
+        registry
+            .build::<dyn Light>("environment", &params, &mut ctx)
+            .expect("the sky map builds")
+    }
+
+    #[test]
+    fn a_map_is_decoded_once_while_a_light_holds_it() {
+        let mut registry = Registry::new();
+        register(&mut registry);
+        let first = sky(&registry, 1.0);
+        let second = sky(&registry, 5.0);
+        // The same map seen from a sphere five times as large.
+        assert!((second.power() / first.power() - 25.0).abs() < 1e-3);
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/environment-sky.exr");
+        let cached = MAPS.get(MapKey::new(&path, 2.0), || {
+            panic!("the map was decoded again")
+        });
+        assert!(cached.is_ok());
+        drop((first, second, cached));
+        // Once no light holds it, the map is freed.
+        let fresh = MAPS.get(MapKey::new(&path, 2.0), || Err("decoded".into()));
+        assert_eq!(fresh.err().as_deref(), Some("decoded"));
+    }
 }
