@@ -282,9 +282,20 @@ fn pack(prims: impl Iterator<Item = Primitive>) -> Tri4 {
 /// (input order), keeping the leaf order `order`.
 fn repack(packets: &mut [Packet], prims: &[Primitive], order: &[u32]) {
     for packet in packets {
-        if let Packet::Triangles { tris, first, count } = packet {
-            let members = &order[*first as usize..(*first + *count) as usize];
-            *tris = pack(members.iter().map(|&i| prims[i as usize]));
+        match packet {
+            Packet::Triangles { tris, first, count } => {
+                let members = &order[*first as usize..(*first + *count) as usize];
+                *tris = pack(members.iter().map(|&i| prims[i as usize]));
+            }
+            Packet::Sphere {
+                centre,
+                radius,
+                prim,
+            } => {
+                if let Primitive::Sphere(c, r) = prims[order[*prim as usize] as usize] {
+                    (*centre, *radius) = (c, r);
+                }
+            }
         }
     }
 }
@@ -455,5 +466,178 @@ impl Primitive {
             }
         };
         (aabb.min.is_finite() && aabb.max.is_finite()).then_some(aabb)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lcg(state: &mut u64) -> f32 {
+        *state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*state >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    /// A grid of small triangles, and the same grid after a large,
+    /// non-rigid move (a twist and a wave).
+    fn soup(n: usize, twist: f32) -> Vec<Primitive> {
+        let mut prims = Vec::new();
+        let mut s = 3;
+        for i in 0..n {
+            let c = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 10.0 - 5.0;
+            let mut v = || c + (Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) - 0.5) * 0.6;
+            let tri = [v(), v(), v()];
+            let moved = tri.map(|p| {
+                let a = twist * p.y;
+                let (sin, cos) = a.sin_cos();
+                Vec3::new(
+                    cos * p.x - sin * p.z,
+                    p.y + twist * (p.x * 0.7).sin(),
+                    sin * p.x + cos * p.z,
+                )
+            });
+            prims.push(if i % 50 == 49 {
+                Primitive::Sphere(moved[0], 0.2)
+            } else {
+                Primitive::Triangle(moved)
+            });
+        }
+        prims
+    }
+
+    /// Every leaf's box holds its primitives, every node's box its
+    /// children's boxes.
+    fn assert_boxes_contain(blas: &Blas, prims: &[Primitive]) {
+        let lanes = blas.hierarchy.wide.lanes();
+        let inside = |outer: &Aabb, inner: &Aabb| {
+            outer.min.cmple(inner.min).all() && outer.max.cmpge(inner.max).all()
+        };
+        for (_, aabb, items, child) in &lanes {
+            match items {
+                Some(range) => {
+                    for packet in &blas.packets[range.clone()] {
+                        let members = match *packet {
+                            Packet::Triangles { first, count, .. } => first..first + count,
+                            Packet::Sphere { prim, .. } => prim..prim + 1,
+                        };
+                        for i in members {
+                            let p = prims[blas.order[i as usize] as usize];
+                            let b = p.aabb().expect("finite primitives");
+                            assert!(inside(aabb, &b), "{b:?} outside its leaf {aabb:?}");
+                        }
+                    }
+                }
+                None => {
+                    for (node, b, ..) in &lanes {
+                        if node == child {
+                            assert!(inside(aabb, b), "child {b:?} outside {aabb:?}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn refitted_boxes_contain_the_moved_primitives() {
+        let before = soup(3000, 0.0);
+        let mut blas = Blas::build(&before, None, BuildQuality::Medium);
+        assert_boxes_contain(&blas, &before);
+        for twist in [0.05, 0.4, 1.5] {
+            let after = soup(3000, twist);
+            let never = UpdatePolicy {
+                rebuild_above: f32::INFINITY,
+            };
+            let update = blas.update(&after, None, never);
+            assert!(!update.rebuilt);
+            assert!(update.degradation > 0.0, "{update:?}");
+            assert_boxes_contain(&blas, &after);
+        }
+    }
+
+    #[test]
+    fn refitted_and_rebuilt_hierarchies_find_the_same_hits() {
+        let after = soup(2000, 0.8);
+        let mut refitted = Blas::build(&soup(2000, 0.0), None, BuildQuality::Medium);
+        let never = UpdatePolicy {
+            rebuild_above: f32::INFINITY,
+        };
+        refitted.update(&after, None, never);
+        let always = UpdatePolicy { rebuild_above: 0.0 };
+        let mut rebuilt = Blas::build(&soup(2000, 0.0), None, BuildQuality::Medium);
+        assert!(rebuilt.update(&after, None, always).rebuilt);
+        let fresh = Blas::build(&after, None, BuildQuality::Medium);
+        let mut s = 17;
+        let mut hits = 0;
+        for _ in 0..20_000 {
+            let o = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 16.0 - 8.0;
+            let d = (Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) - 0.5).normalize();
+            let closest = |b: &Blas| {
+                let h = b.closest::<super::super::wide::Baseline>(o, d, f32::INFINITY, 0.0, 0);
+                (h.prim != Hit::MISS.prim).then(|| (h.t, b.order[h.prim as usize]))
+            };
+            let expected = closest(&fresh);
+            assert_eq!(closest(&refitted), expected);
+            assert_eq!(closest(&rebuilt), expected);
+            hits += usize::from(expected.is_some());
+            let any = |b: &Blas| b.any::<super::super::wide::Baseline>(o, d, 3.0, 0.0);
+            assert_eq!(any(&refitted), any(&fresh));
+        }
+        assert!(hits > 2000, "only {hits} rays hit");
+    }
+
+    #[test]
+    fn deforming_triangles_are_hit_where_they_are_at_the_ray_time() {
+        let open = soup(500, 0.0);
+        let close = soup(500, 0.6);
+        let moving = Blas::build(&open, Some(&close), BuildQuality::Medium);
+        let mut s = 29;
+        let mut hits = 0;
+        for _ in 0..5000 {
+            let tau = lcg(&mut s);
+            let at: Vec<Primitive> = open
+                .iter()
+                .zip(&close)
+                .map(|(a, b)| match (a, b) {
+                    (Primitive::Triangle(a), Primitive::Triangle(b)) => {
+                        Primitive::Triangle(std::array::from_fn(|k| a[k] + (b[k] - a[k]) * tau))
+                    }
+                    (Primitive::Sphere(c, r), Primitive::Sphere(..)) => Primitive::Sphere(*c, *r),
+                    _ => unreachable!(),
+                })
+                .collect();
+            let o = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 16.0 - 8.0;
+            let d = (Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) - 0.5).normalize();
+            let h = moving.closest::<super::super::wide::Baseline>(o, d, f32::INFINITY, tau, 0);
+            // Brute force over the triangles where they are at τ.
+            let prep = RayPrep::new(o, d);
+            let expected = at
+                .iter()
+                .enumerate()
+                .filter_map(|(i, p)| match p {
+                    Primitive::Triangle(v) => Tri4::new(std::slice::from_ref(v))
+                        .closest(&prep, f32::INFINITY)
+                        .map(|h| (h.t, i as u32)),
+                    Primitive::Sphere(c, r) => {
+                        sphere::intersect(o, d, *c, *r, f32::INFINITY).map(|t| (t, i as u32))
+                    }
+                })
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            let got = (h.prim != Hit::MISS.prim).then(|| (h.t, moving.order[h.prim as usize]));
+            match (got, expected) {
+                (None, None) => {}
+                (Some((t, i)), Some((u, j))) => {
+                    assert!((t - u).abs() <= 1e-4 * u.max(1.0), "t {t} vs {u}");
+                    if i != j {
+                        assert!((t - u).abs() <= 1e-5 * u.max(1.0));
+                    }
+                    hits += 1;
+                }
+                other => panic!("moving hierarchy and brute force disagree at τ {tau}: {other:?}"),
+            }
+        }
+        assert!(hits > 100, "only {hits} rays hit");
     }
 }

@@ -843,4 +843,222 @@ mod tests {
         assert!(accel.occluded(Vec3::new(0.2, 0.2, 0.5), -Vec3::Z, 1.0));
         assert!(!accel.occluded(Vec3::new(0.2, 0.2, 0.5), Vec3::Z, 0.4));
     }
+
+    /// Random triangles and spheres around the origin, in object space.
+    fn object(seed: u64, n: usize) -> Vec<Primitive> {
+        let mut s = seed;
+        (0..n)
+            .map(|i| {
+                let c = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 2.0 - 1.0;
+                if i % 7 == 6 {
+                    Primitive::Sphere(c, 0.05 + 0.1 * lcg(&mut s))
+                } else {
+                    let mut v =
+                        || c + (Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) - 0.5) * 0.5;
+                    Primitive::Triangle([v(), v(), v()])
+                }
+            })
+            .collect()
+    }
+
+    /// `prims` moved to render space by `m` (spheres by a similarity).
+    fn placed(prims: &[Primitive], m: glam::DMat4) -> Vec<Primitive> {
+        let p = |v: Vec3| m.transform_point3(v.as_dvec3()).as_vec3();
+        let scale = m.transform_vector3(glam::DVec3::X).length() as f32;
+        prims
+            .iter()
+            .map(|prim| match *prim {
+                Primitive::Triangle(v) => Primitive::Triangle(v.map(p)),
+                Primitive::Sphere(c, r) => Primitive::Sphere(p(c), r * scale),
+            })
+            .collect()
+    }
+
+    /// Similarity transforms for instances (spheres stay spheres).
+    fn placements(seed: u64, n: usize) -> Vec<glam::DMat4> {
+        let mut s = seed;
+        (0..n)
+            .map(|_| {
+                let axis = (Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) - 0.5)
+                    .normalize()
+                    .as_dvec3();
+                glam::DMat4::from_scale_rotation_translation(
+                    glam::DVec3::splat(0.5 + f64::from(lcg(&mut s))),
+                    glam::DQuat::from_axis_angle(axis, f64::from(lcg(&mut s)) * 6.0),
+                    (Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 12.0 - 6.0).as_dvec3(),
+                )
+            })
+            .collect()
+    }
+
+    #[test]
+    fn two_levels_find_the_hits_of_one() {
+        // Two shapes: one static in render space, one instanced five times.
+        let statics = object(1, 300);
+        let shape = object(2, 200);
+        let places = placements(3, 5);
+        let mut flat = statics.clone();
+        for m in &places {
+            flat.extend(placed(&shape, *m));
+        }
+        let (one, order) = Accel::build(&flat, BuildQuality::Medium);
+        let blases = vec![
+            Blas::build(&statics, None, BuildQuality::Medium),
+            Blas::build(&shape, None, BuildQuality::Medium),
+        ];
+        let mut instances = vec![Instance {
+            blas: 0,
+            place: Place::Identity,
+        }];
+        instances.extend(places.iter().map(|m| Instance {
+            blas: 1,
+            place: Place::Fixed(Placement::new(*m).expect("invertible")),
+        }));
+        let two = Accel::new(blases, instances, BuildQuality::Medium);
+        assert!(!two.direct);
+        // The flat soup's primitive `i` as (instance, primitive of its shape).
+        let identity = |i: usize| {
+            if i < statics.len() {
+                (0, i)
+            } else {
+                let k = i - statics.len();
+                (1 + k / shape.len(), k % shape.len())
+            }
+        };
+        let mut s = 9;
+        let mut hits = 0;
+        for _ in 0..20_000 {
+            let o = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 20.0 - 10.0;
+            let target = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 12.0 - 6.0;
+            let d = (target - o).normalize();
+            let a = one.intersect(o, d, f32::INFINITY);
+            let b = two.intersect(o, d, f32::INFINITY);
+            match (a, b) {
+                (None, None) => {}
+                (Some(a), Some(b)) => {
+                    hits += 1;
+                    // Instances see the ray through a transform: equal up to
+                    // its rounding.
+                    assert!(
+                        (a.t - b.t).abs() <= 1e-4 * a.t.max(1.0),
+                        "t {} vs {}",
+                        a.t,
+                        b.t
+                    );
+                    let (inst, local) = identity(order[a.prim as usize] as usize);
+                    let blas = two.instances[b.inst as usize].blas as usize;
+                    let got = two.blases[blas].order()[(b.prim - two.bases[blas]) as usize];
+                    if (b.inst as usize, got as usize) != (inst, local) {
+                        assert!((a.t - b.t).abs() <= 1e-4 * a.t.max(1.0));
+                    }
+                }
+                // A graze at an edge may go either way after a transform.
+                (a, b) => {
+                    let t = a.or(b).map_or(0.0, |h| h.t);
+                    assert!(
+                        one.occluded(o, d, t * 1.001) && !one.occluded(o, d, t * 0.999)
+                            || two.occluded(o, d, t * 1.001),
+                        "one and two levels disagree: {a:?} vs {b:?}"
+                    );
+                }
+            }
+            let tmax = lcg(&mut s) * 10.0;
+            if one.occluded(o, d, tmax * 0.999) {
+                assert!(two.occluded(o, d, tmax), "shadow ray leaked");
+            }
+        }
+        assert!(hits > 2000, "only {hits} rays hit");
+    }
+
+    #[test]
+    fn a_moving_instance_is_hit_where_it_is_at_the_ray_time() {
+        let shape = object(4, 150);
+        let motion = Motion {
+            outer: glam::DMat4::from_translation(glam::DVec3::new(0.0, 0.0, -3.0)),
+            open: crate::world::Trs::IDENTITY,
+            close: crate::world::Trs {
+                translate: glam::DVec3::new(2.0, 0.5, 0.0),
+                rotate: glam::DQuat::from_rotation_y(2.5),
+                scale: glam::DVec3::splat(1.5),
+            },
+            inner: glam::DMat4::from_translation(glam::DVec3::new(0.5, 0.0, 0.0)),
+        };
+        let moving = Accel::new(
+            vec![Blas::build(&shape, None, BuildQuality::Medium)],
+            vec![Instance {
+                blas: 0,
+                place: Place::Moving(motion),
+            }],
+            BuildQuality::Medium,
+        );
+        let mut s = 21;
+        let mut hits = 0;
+        for _ in 0..4000 {
+            let tau = lcg(&mut s);
+            let fixed = Accel::new(
+                vec![Blas::build(&shape, None, BuildQuality::Medium)],
+                vec![Instance {
+                    blas: 0,
+                    place: Place::Fixed(motion.at(tau).expect("invertible")),
+                }],
+                BuildQuality::Medium,
+            );
+            let o = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 8.0 - 4.0;
+            let target =
+                Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 4.0 - Vec3::new(1.0, 2.0, 5.0);
+            let d = (target - o).normalize();
+            let a = moving.intersect_at(o, d, f32::INFINITY, tau);
+            let b = fixed.intersect(o, d, f32::INFINITY);
+            assert_eq!(
+                a.map(|h| (h.t, h.prim)),
+                b.map(|h| (h.t, h.prim)),
+                "τ {tau}"
+            );
+            assert_eq!(
+                moving.occluded_at(o, d, 5.0, tau),
+                fixed.occluded(o, d, 5.0),
+                "τ {tau}"
+            );
+            hits += usize::from(a.is_some());
+        }
+        assert!(hits > 300, "only {hits} rays hit");
+    }
+
+    #[test]
+    fn the_top_level_follows_moved_instances() {
+        let shape = object(5, 100);
+        let start = placements(6, 40);
+        let end = placements(7, 40);
+        let build = |ms: &[glam::DMat4]| {
+            Accel::new(
+                vec![Blas::build(&shape, None, BuildQuality::Medium)],
+                ms.iter()
+                    .map(|m| Instance {
+                        blas: 0,
+                        place: Place::Fixed(Placement::new(*m).expect("invertible")),
+                    })
+                    .collect(),
+                BuildQuality::Medium,
+            )
+        };
+        let fresh = build(&end);
+        for rebuild_above in [f32::INFINITY, 0.0] {
+            let mut moved = build(&start);
+            for (inst, m) in moved.instances_mut().iter_mut().zip(&end) {
+                inst.place = Place::Fixed(Placement::new(*m).expect("invertible"));
+            }
+            let update = moved.update_top_level(UpdatePolicy { rebuild_above });
+            assert_eq!(update.rebuilt, rebuild_above == 0.0);
+            let mut s = 33;
+            for _ in 0..5000 {
+                let o = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 20.0 - 10.0;
+                let d = (Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) - 0.5).normalize();
+                let key = |h: Option<Hit>| h.map(|h| (h.t, h.inst, h.prim));
+                assert_eq!(
+                    key(moved.intersect(o, d, f32::INFINITY)),
+                    key(fresh.intersect(o, d, f32::INFINITY))
+                );
+            }
+        }
+    }
 }
