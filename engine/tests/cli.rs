@@ -505,3 +505,154 @@ fn compare_refuses_non_finite_images_and_names_both_sizes() {
         "{err}"
     );
 }
+
+/// A small animated scene: a cube sliding in front of a lit wall.
+const ANIMATED: &str = "
+animation: {fps: 24, frames: [1, 3]}
+film: {width: 24, height: 24}
+sampler: {type: independent, spp: 2}
+camera: {type: perspective, look_at: {origin: [0, 0, 4], target: [0, 0, 0]}}
+shapes:
+  - {type: rectangle, transform: {translate: [0, 0, -1]}}
+  - type: cube
+    transform: {scale: 0.3}
+    animation:
+      translate: {keyframes: [{frame: 1, value: [-0.5, 0, 0]}, {frame: 3, value: [0.5, 0, 0]}]}
+lights:
+  - {type: point, position: [0, 0, 3], intensity: 10}
+";
+
+/// Writes the animated scene into a new folder; returns both.
+fn animated_scene() -> (tempfile::TempDir, PathBuf) {
+    let (dir, path) = temp("anim.yaml");
+    std::fs::write(&path, ANIMATED).unwrap();
+    (dir, path)
+}
+
+#[test]
+fn frame_ranges_render_each_frame_to_its_numbered_file() {
+    let (dir, scene) = animated_scene();
+    let pattern = dir.path().join("f_##.exr");
+    let o = radiant(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--frames",
+        "1..3",
+        "-o",
+        pattern.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    for f in 1..=3 {
+        assert!(dir.path().join(format!("f_0{f}.exr")).exists(), "frame {f}");
+        assert!(
+            err.contains(&format!("frame {f}: rendered 24x24, 2 spp")),
+            "{err}"
+        );
+    }
+    let last = err.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("sequence: 3 frames in ")
+            && last.contains("scene update")
+            && last.contains("BVH update")
+            && last.contains("rendering"),
+        "{last}"
+    );
+    // Frame 2 alone is frame 2 of the sequence, byte for byte.
+    let single = dir.path().join("alone_#.exr");
+    let o = radiant(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--frames",
+        "2",
+        "-o",
+        single.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read(dir.path().join("alone_2.exr")).unwrap(),
+        std::fs::read(dir.path().join("f_02.exr")).unwrap()
+    );
+}
+
+#[test]
+fn skip_existing_resumes_a_sequence() {
+    let (dir, scene) = animated_scene();
+    let done = dir.path().join("f_2.png");
+    std::fs::write(&done, b"finished earlier").unwrap();
+    let o = radiant(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--frames",
+        "1..3",
+        "--skip-existing",
+        "-o",
+        dir.path().join("f_#.png").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&done).unwrap(), b"finished earlier");
+    assert!(dir.path().join("f_1.png").exists() && dir.path().join("f_3.png").exists());
+    let err = stderr(&o);
+    assert!(!err.contains("frame 2:"), "{err}");
+    assert!(
+        err.contains("2 frames") && err.contains("1 existing frames skipped"),
+        "{err}"
+    );
+}
+
+#[test]
+fn bad_frame_requests_fail_and_write_nothing() {
+    let (dir, scene) = animated_scene();
+    let s = scene.to_str().unwrap();
+    let pattern = dir.path().join("f_#.png");
+    let p = pattern.to_str().unwrap();
+    for (args, needle) in [
+        (
+            vec!["--frames", "0..2", "-o", p],
+            "outside the scene's frames 1..3",
+        ),
+        (
+            vec!["--frames", "2..9", "-o", p],
+            "outside the scene's frames 1..3",
+        ),
+        (vec!["--frames", "3..1", "-o", p], "empty"),
+        (vec!["--frames", "x", "-o", p], "not a frame number"),
+    ] {
+        let mut full = vec!["render", s];
+        full.extend(args);
+        let o = radiant(&full);
+        assert!(!o.status.success());
+        assert!(stderr(&o).contains(needle), "{}", stderr(&o));
+    }
+    // Several frames need a run of `#` in the output name.
+    let plain = dir.path().join("one.png");
+    let o = radiant(&[
+        "render",
+        s,
+        "--frames",
+        "1..3",
+        "-o",
+        plain.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("put a run of `#`"), "{}", stderr(&o));
+    let files: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(files.len(), 1, "only the scene file: {files:?}");
+}
+
+#[test]
+fn info_reports_the_animation() {
+    let (_dir, scene) = animated_scene();
+    let o = radiant(&["info", scene.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(
+        out.contains("animation    frames 1..3 (3 at 24 fps), no shutter"),
+        "{out}"
+    );
+    assert!(
+        out.contains("animated     1 shapes moving, 0 deforming meshes"),
+        "{out}"
+    );
+    assert!(out.contains("instances    2 in the top level"), "{out}");
+}

@@ -237,19 +237,37 @@ impl<'f> KeyframeReader<'f> {
     /// one at a place that cannot animate.
     pub(crate) fn check_all_read(&self, doc: &Node) -> Result<(), SceneError> {
         if is_keyframes(doc) && !start_of(doc).is_some_and(|s| self.read.contains(&s)) {
-            return Err(self.error(
-                doc,
-                "this value cannot animate: `keyframes` may give the numbers and colours of \
-                 cameras, lights, materials and textures, the points of a camera's `look_at`, \
-                 and the `translate`, `rotate` and `scale` tracks of an `animation:` on a shape, \
-                 light or camera",
-            ));
+            return Err(cannot_animate(self.file, doc));
         }
         match doc {
             Node::Mapping(m) => m.values().try_for_each(|v| self.check_all_read(v)),
             Node::Sequence(s) => s.iter().try_for_each(|v| self.check_all_read(v)),
             Node::Scalar(_) => Ok(()),
         }
+    }
+}
+
+/// The error for `keyframes` at `node`, a place that cannot animate.
+pub(crate) fn cannot_animate(file: &Path, node: &Node) -> SceneError {
+    SceneError::new(
+        file,
+        loc(node.span()),
+        "this value cannot animate: `keyframes` may give the numbers and colours of \
+         cameras, lights, materials and textures, the points of a camera's `look_at`, \
+         and the `translate`, `rotate` and `scale` tracks of an `animation:` on a shape, \
+         light or camera",
+    )
+}
+
+/// The first `keyframes` mapping in `node`, if any.
+pub(crate) fn find_keyframes(node: &Node) -> Option<&Node> {
+    if is_keyframes(node) {
+        return Some(node);
+    }
+    match node {
+        Node::Mapping(m) => m.values().find_map(find_keyframes),
+        Node::Sequence(s) => s.iter().find_map(find_keyframes),
+        Node::Scalar(_) => None,
     }
 }
 

@@ -102,8 +102,13 @@ pub(crate) fn parse_document(file: &Path, text: &str) -> Result<Node, SceneError
     })
 }
 
-/// Deserializes `node` with serde, keeping positions in errors.
+/// Deserializes `node` with serde, keeping positions in errors; values the
+/// engine reads itself cannot animate, so `keyframes` in `node` are an
+/// error.
 pub(crate) fn parse_node<T: DeserializeOwned>(file: &Path, node: &Node) -> Result<T, SceneError> {
+    if let Some(k) = super::keyframes::find_keyframes(node) {
+        return Err(super::keyframes::cannot_animate(file, k));
+    }
     Params::new(node.clone())
         .parse()
         .map_err(|e| SceneError::from_param(file, e))
