@@ -6,6 +6,7 @@ mod film_args;
 mod info;
 mod modules;
 mod render;
+mod sheet;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -32,6 +33,8 @@ enum Command {
     },
     /// List every registered module type with its parameters and defaults.
     Modules,
+    /// Show rendered frames as a contact sheet (.png) or an animated GIF (.gif).
+    Sheet(sheet::SheetArgs),
     /// Compare an image against a reference (RMSE, relative MSE, mean ratio).
     Compare {
         /// The image to judge (EXR).
@@ -55,6 +58,7 @@ pub fn run() -> ExitCode {
         Command::Render(args) => render::run(&registry, &args),
         Command::Accuracy(args) => accuracy::run(&registry, &args),
         Command::Info { scene } => info::run(&registry, &scene),
+        Command::Sheet(args) => sheet::run(&args),
         Command::Modules => {
             modules::run(&registry);
             Ok(())

@@ -49,7 +49,7 @@ pub struct RenderArgs {
 }
 
 /// Parses `A..B` or `N`.
-fn parse_frames(text: &str) -> Result<(i64, i64), String> {
+pub fn parse_frames(text: &str) -> Result<(i64, i64), String> {
     let number = |s: &str| {
         s.trim()
             .parse::<i64>()
@@ -106,7 +106,7 @@ fn check_output(output: &Path) -> miette::Result<()> {
 }
 
 /// The output file of `frame`.
-fn frame_path(output: &Path, frame: i64) -> PathBuf {
+pub(super) fn frame_path(output: &Path, frame: i64) -> PathBuf {
     let name = output
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())

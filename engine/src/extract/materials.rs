@@ -8,7 +8,7 @@
 //! itself, and bounds how deep named materials may nest.
 
 use crate::error::module_error;
-use crate::scene::{Scene, module_spec};
+use crate::world::{ModuleSpec, Scene};
 use marked_yaml::Node;
 use radiant_core::registry::ModuleType;
 use radiant_core::{BuildContext, MaterialSource, ModuleKind, ParamError, Registry, Shader};
@@ -73,7 +73,7 @@ impl MaterialSource for NestedMaterials<'_> {
         ctx: &mut BuildContext<'_>,
     ) -> Result<Box<dyn Shader>, ParamError> {
         let file = &self.scene.file;
-        let to_param = |e: crate::scene::SceneError| ParamError {
+        let to_param = |e: crate::error::SceneError| ParamError {
             message: e.message,
             location: e.location,
         };
@@ -122,7 +122,7 @@ impl MaterialSource for NestedMaterials<'_> {
             )
         } else {
             (
-                module_spec(file, node, "material", &[]).map_err(to_param)?,
+                ModuleSpec::from_node(file, node, "material", &[]).map_err(to_param)?,
                 None,
             )
         };

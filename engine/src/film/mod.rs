@@ -10,6 +10,7 @@
 //! sampling and added to one pixel ([`FilterSampler`], pbrt-v4).
 
 pub mod output;
+pub mod sheet;
 
 use crate::settings::FilterSampling;
 use glam::{Vec2, Vec4};

@@ -49,7 +49,6 @@ use serde::Deserialize;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-pub(crate) use yaml::module_spec;
 use yaml::{Mapping, closest, loc, parse_node};
 
 const TOP_KEYS: &[&str] = &[
@@ -269,14 +268,14 @@ impl Loader<'_> {
     /// Spawns the camera; returns the shutter.
     fn camera(&mut self, world: &mut World, node: &Node) -> Result<Option<(f64, f64)>, SceneError> {
         let file = self.file;
-        let mut module = module_spec(
+        let mut module = ModuleSpec::from_node(
             file,
             node,
             "camera",
             &["look_at", "transform", "animation", "shutter"],
         )?;
         self.keyframes.module_tracks(&mut module)?;
-        let map = node.as_mapping().expect("module_spec checked the mapping");
+        let map = node.as_mapping().expect("from_node checked the mapping");
         let (look, transform, animation) = (
             map.get_node("look_at"),
             map.get_node("transform"),
@@ -392,9 +391,9 @@ impl Loader<'_> {
     /// Spawns a light of `lights:`.
     fn light(&mut self, world: &mut World, node: &Node) -> Result<(), SceneError> {
         let file = self.file;
-        let mut spec = module_spec(file, node, "light", &["transform", "animation"])?;
+        let mut spec = ModuleSpec::from_node(file, node, "light", &["transform", "animation"])?;
         self.keyframes.module_tracks(&mut spec)?;
-        let map = node.as_mapping().expect("module_spec checked the mapping");
+        let map = node.as_mapping().expect("from_node checked the mapping");
         let transform = match map.get_node("transform") {
             Some(t) => transform::parse_transform(file, t)?,
             None => DMat4::IDENTITY,
@@ -521,7 +520,7 @@ fn parse_integrator(
     let Some(node) = node else {
         return Ok((-1, 5, LightSelection::default()));
     };
-    let spec = module_spec(file, node, "integrator", &[])?;
+    let spec = ModuleSpec::from_node(file, node, "integrator", &[])?;
     if !INTEGRATORS.contains(&spec.type_name.as_str()) {
         return Err(unknown_type(file, &spec, "integrator", INTEGRATORS));
     }
@@ -588,7 +587,7 @@ fn parse_film(
     };
     let mut map = Mapping::new(file, node, "film")?;
     let filter = match map.get("filter") {
-        Some(f) => module_spec(file, f, "filter", &[])?,
+        Some(f) => ModuleSpec::from_node(file, f, "filter", &[])?,
         None => default_module("gaussian"),
     };
     let width = map.get("width");
@@ -633,7 +632,7 @@ fn parse_sampler(
     let Some(node) = node else {
         return Ok((default_spp(), default_module("independent")));
     };
-    let spec = module_spec(file, node, "sampler", &["spp"])?;
+    let spec = ModuleSpec::from_node(file, node, "sampler", &["spp"])?;
     let mut keys = marked_yaml::types::MarkedMappingNode::new_empty(*node.span());
     if let Some((k, v)) = node
         .as_mapping()
@@ -671,7 +670,7 @@ fn named_modules(
         .map(|(name, def)| {
             Ok((
                 name.as_str().to_string(),
-                module_spec(file, def, what, &[])?,
+                ModuleSpec::from_node(file, def, what, &[])?,
             ))
         })
         .collect()
@@ -741,7 +740,7 @@ fn parse_shape(loader: &mut Loader<'_>, node: &Node, index: usize) -> Result<Sha
     };
     let emitter = map
         .get("emitter")
-        .map(|e| module_spec(file, e, "emitter", &[]))
+        .map(|e| ModuleSpec::from_node(file, e, "emitter", &[]))
         .transpose()?;
     let material = parse_material_ref(loader, map.get("material"), &name)?;
     let flip_node = map.get("flip_normals");
@@ -920,7 +919,7 @@ fn parse_material_ref(
             })
         }
         Some(n) => {
-            let mut spec = module_spec(file, n, "material", &[])?;
+            let mut spec = ModuleSpec::from_node(file, n, "material", &[])?;
             loader.keyframes.module_tracks(&mut spec)?;
             loader
                 .materials

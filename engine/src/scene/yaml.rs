@@ -1,7 +1,6 @@
 //! Reading the scene's YAML tree with positions kept for every node.
 
 use super::SceneError;
-use crate::world::ModuleSpec;
 use marked_yaml::types::MarkedMappingNode;
 use marked_yaml::{Node, Span};
 use radiant_core::Params;
@@ -228,47 +227,4 @@ pub(crate) fn closest<'c>(word: &str, candidates: &[&'c str]) -> Option<&'c str>
         .filter(|(d, c)| *d <= 2.max(c.len() / 3))
         .min()
         .map(|(_, c)| c)
-}
-
-/// Splits a module mapping into its `type` and the parameters the module
-/// parses, leaving out `engine_keys` (which the caller reads from the
-/// returned mapping).
-pub(crate) fn module_spec(
-    file: &Path,
-    node: &Node,
-    what: &str,
-    engine_keys: &[&str],
-) -> Result<ModuleSpec, SceneError> {
-    let map = node.as_mapping().ok_or_else(|| {
-        SceneError::new(
-            file,
-            loc(node.span()),
-            format!("expected a mapping with a `type` for the {what}"),
-        )
-    })?;
-    let type_node = map.get_node("type").ok_or_else(|| {
-        SceneError::new(file, loc(node.span()), format!("the {what} needs a `type`"))
-    })?;
-    let type_name = type_node
-        .as_scalar()
-        .ok_or_else(|| {
-            SceneError::new(
-                file,
-                loc(type_node.span()),
-                format!("the {what}'s `type` must be a name"),
-            )
-        })?
-        .as_str()
-        .to_string();
-    let mut rest = MarkedMappingNode::new_empty(*node.span());
-    for (k, v) in map.iter() {
-        if k.as_str() != "type" && !engine_keys.contains(&k.as_str()) {
-            rest.insert(k.clone(), v.clone());
-        }
-    }
-    Ok(ModuleSpec::new(
-        type_name,
-        loc(type_node.span()),
-        Params::new(Node::Mapping(rest)),
-    ))
 }

@@ -96,6 +96,53 @@ pub struct ModuleSpec {
 }
 
 impl ModuleSpec {
+    /// Splits a module mapping into its `type` and the parameters the
+    /// module parses, leaving out `engine_keys` (which the caller reads
+    /// from the node itself); `what` names the module in errors.
+    pub fn from_node(
+        file: &std::path::Path,
+        node: &marked_yaml::Node,
+        what: &str,
+        engine_keys: &[&str],
+    ) -> Result<Self, crate::error::SceneError> {
+        use crate::error::SceneError;
+        use marked_yaml::Node;
+        use marked_yaml::types::MarkedMappingNode;
+        let loc = |n: &Node| Location::of(n.span());
+        let map = node.as_mapping().ok_or_else(|| {
+            SceneError::new(
+                file,
+                loc(node),
+                format!("expected a mapping with a `type` for the {what}"),
+            )
+        })?;
+        let type_node = map.get_node("type").ok_or_else(|| {
+            SceneError::new(file, loc(node), format!("the {what} needs a `type`"))
+        })?;
+        let type_name = type_node
+            .as_scalar()
+            .ok_or_else(|| {
+                SceneError::new(
+                    file,
+                    loc(type_node),
+                    format!("the {what}'s `type` must be a name"),
+                )
+            })?
+            .as_str()
+            .to_string();
+        let mut rest = MarkedMappingNode::new_empty(*node.span());
+        for (k, v) in map.iter() {
+            if k.as_str() != "type" && !engine_keys.contains(&k.as_str()) {
+                rest.insert(k.clone(), v.clone());
+            }
+        }
+        Ok(Self::new(
+            type_name,
+            loc(type_node),
+            Params::new(Node::Mapping(rest)),
+        ))
+    }
+
     /// A module spec with fixed parameters.
     pub fn new(type_name: String, location: Option<Location>, params: Params) -> Self {
         Self {
