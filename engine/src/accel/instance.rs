@@ -59,15 +59,7 @@ impl Placement {
     /// hit at `t'` on the new ray lies at `t' + dt` on the old one.
     #[inline]
     pub fn ray_to_object(&self, origin: Vec3, dir: Vec3) -> (Vec3, Vec3, f32) {
-        let m = &self.to_object;
-        let o = Vec3A::from(origin);
-        let po = m.transform_point3a(o);
-        let d = m.transform_vector3a(Vec3A::from(dir));
-        let err = abs_mul(&m.matrix3, o.abs()) + m.translation.abs();
-        let err = err * GAMMA3;
-        let l2 = d.length_squared();
-        let dt = if l2 > 0.0 { d.abs().dot(err) / l2 } else { 0.0 };
-        (Vec3::from(po + d * dt), Vec3::from(d), dt)
+        ray_to_object(&self.to_object, origin, dir)
     }
 
     /// Point `p` with error bound `err` (object space) in render space,
@@ -97,6 +89,20 @@ impl Placement {
         }
         out
     }
+}
+
+/// The ray `origin + t·dir` through `m` (render to object space), its
+/// origin moved forward past the transform's rounding error; see
+/// [`Placement::ray_to_object`].
+#[inline(always)]
+pub(super) fn ray_to_object(m: &Affine3A, origin: Vec3, dir: Vec3) -> (Vec3, Vec3, f32) {
+    let o = Vec3A::from(origin);
+    let po = m.transform_point3a(o);
+    let d = m.transform_vector3a(Vec3A::from(dir));
+    let err = (abs_mul(&m.matrix3, o.abs()) + m.translation.abs()) * GAMMA3;
+    let l2 = d.length_squared();
+    let dt = if l2 > 0.0 { d.abs().dot(err) / l2 } else { 0.0 };
+    (Vec3::from(po + d * dt), Vec3::from(d), dt)
 }
 
 /// |m|·v: each entry of `m` by its absolute value.

@@ -77,14 +77,15 @@ impl Hit {
 }
 
 /// Where an instance's bottom level lies in render space.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Place {
     /// Already in render space (the merged static shapes).
     Identity,
     /// Through a fixed transform.
     Fixed(Placement),
-    /// Through a transform that moves while the shutter is open.
-    Moving(Motion),
+    /// Through a transform that moves while the shutter is open (boxed:
+    /// four matrices, which would make every instance four times larger).
+    Moving(Box<Motion>),
 }
 
 impl Place {
@@ -101,7 +102,7 @@ impl Place {
 }
 
 /// A bottom level placed in render space.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Instance {
     /// Index of the bottom level.
     pub blas: u32,
@@ -119,6 +120,9 @@ pub struct Accel {
     tlas: Hierarchy,
     /// Instance indices in the top level's leaf order.
     tlas_items: Vec<u32>,
+    /// What traversal needs of each instance, in the top level's leaf order
+    /// (instances a ray meets one after the other lie side by side).
+    tlas_entries: Vec<TopEntry>,
     /// Whether queries go straight to instance 0 (one instance, no
     /// placement).
     direct: bool,
@@ -163,6 +167,7 @@ impl Accel {
             instances,
             tlas: Hierarchy::default(),
             tlas_items: Vec::new(),
+            tlas_entries: Vec::new(),
             direct,
             quality,
             avx2: Avx2::detected(),
@@ -196,14 +201,20 @@ impl Accel {
             .collect()
     }
 
-    /// The render-space box of instance `i` (containing its motion).
+    /// The render-space box of instance `i` (containing its motion): the
+    /// union of its bottom level's top boxes placed, tighter than its
+    /// whole box placed where the placement turns it.
     pub fn instance_bounds(&self, i: usize) -> Option<Aabb> {
         let inst = &self.instances[i];
-        let b = self.blases[inst.blas as usize].bounds()?;
+        let blas = &self.blases[inst.blas as usize];
         let placed = match &inst.place {
-            Place::Identity => b,
-            Place::Fixed(p) => p.bounds(&b),
-            Place::Moving(m) => m.bounds(&b),
+            Place::Identity => blas.bounds()?,
+            Place::Fixed(p) => blas
+                .cover()
+                .iter()
+                .map(|b| p.bounds(b))
+                .reduce(|a, b| a.union(&b))?,
+            Place::Moving(m) => m.bounds(&blas.bounds()?),
         };
         (placed.min.is_finite() && placed.max.is_finite()).then_some(placed)
     }
@@ -215,6 +226,31 @@ impl Accel {
         self.tlas = Hierarchy::build(&boxes, self.quality, LeafCost::INSTANCES, |leaf| {
             store_instances(leaf, items)
         });
+        self.lay_out_entries();
+    }
+
+    /// Writes the traversal entries in leaf order.
+    fn lay_out_entries(&mut self) {
+        let (instances, bases) = (&self.instances, &self.bases);
+        self.tlas_entries = self
+            .tlas_items
+            .iter()
+            .map(|&i| {
+                let inst = &instances[i as usize];
+                let (kind, to_object) = match &inst.place {
+                    Place::Identity => (EntryKind::Identity, glam::Affine3A::IDENTITY),
+                    Place::Fixed(p) => (EntryKind::Fixed, p.to_object),
+                    Place::Moving(_) => (EntryKind::Moving, glam::Affine3A::IDENTITY),
+                };
+                TopEntry {
+                    to_object,
+                    inst: i,
+                    blas: inst.blas,
+                    base: bases[inst.blas as usize],
+                    kind,
+                }
+            })
+            .collect();
     }
 
     /// Updates the top level after instances moved ([`Accel::instances_mut`])
@@ -231,6 +267,7 @@ impl Accel {
         if update.rebuilt {
             *items = fresh;
         }
+        self.lay_out_entries();
         update.time = start.elapsed();
         self.build_time = update.time;
         update
@@ -527,6 +564,30 @@ fn store_instances(leaf: &[u32], items: &mut Vec<u32>) -> Range<u32> {
     start..items.len() as u32
 }
 
+/// How a ray enters an instance.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum EntryKind {
+    /// As it is.
+    Identity,
+    /// Through the entry's `to_object`.
+    Fixed,
+    /// Through the instance's motion at the ray's time.
+    Moving,
+}
+
+/// An instance as top-level traversal reads it.
+#[derive(Debug, Clone, Copy)]
+struct TopEntry {
+    /// Render space to object space (for [`EntryKind::Fixed`]).
+    to_object: glam::Affine3A,
+    /// The instance.
+    inst: u32,
+    /// Its bottom level, and that level's first primitive number.
+    blas: u32,
+    base: u32,
+    kind: EntryKind,
+}
+
 /// One ray's query of the top level: at each leaf, the ray enters each
 /// instance's space and traverses its bottom level.
 struct TopQuery<'a, I> {
@@ -539,15 +600,22 @@ struct TopQuery<'a, I> {
 }
 
 impl<I: Isa> TopQuery<'_, I> {
-    /// The ray in instance `inst`'s space at the query's time: origin,
+    /// The ray in `entry`'s instance space at the query's time: origin,
     /// direction and how far the origin moved along the ray; `None` where
     /// the instance cannot be entered (a singular transform).
     #[inline(always)]
-    fn enter(&self, inst: &Instance) -> Option<(Vec3, Vec3, f32)> {
-        match &inst.place {
-            Place::Identity => Some((self.origin, self.dir, 0.0)),
-            Place::Fixed(p) => Some(p.ray_to_object(self.origin, self.dir)),
-            Place::Moving(m) => Some(m.at(self.tau)?.ray_to_object(self.origin, self.dir)),
+    fn enter(&self, entry: &TopEntry) -> Option<(Vec3, Vec3, f32)> {
+        match entry.kind {
+            EntryKind::Identity => Some((self.origin, self.dir, 0.0)),
+            EntryKind::Fixed => Some(instance::ray_to_object(
+                &entry.to_object,
+                self.origin,
+                self.dir,
+            )),
+            EntryKind::Moving => match &self.accel.instances[entry.inst as usize].place {
+                Place::Moving(m) => Some(m.at(self.tau)?.ray_to_object(self.origin, self.dir)),
+                _ => None,
+            },
         }
     }
 }
@@ -556,19 +624,17 @@ impl<I: Isa> LeafVisitor for TopQuery<'_, I> {
     #[inline(always)]
     fn closest(&mut self, range: Range<usize>, mut tmax: f32) -> f32 {
         let accel = self.accel;
-        for &i in &accel.tlas_items[range] {
-            let inst = &accel.instances[i as usize];
-            let Some((o, d, dt)) = self.enter(inst) else {
+        for entry in &accel.tlas_entries[range] {
+            let Some((o, d, dt)) = self.enter(entry) else {
                 continue;
             };
-            let blas = inst.blas as usize;
-            let base = accel.bases[blas];
-            let hit = accel.blases[blas].closest::<I>(o, d, tmax - dt, self.tau, base);
+            let blas = &accel.blases[entry.blas as usize];
+            let hit = blas.closest::<I>(o, d, tmax - dt, self.tau, entry.base);
             if hit.prim != Hit::MISS.prim {
                 tmax = hit.t + dt;
                 self.best = Hit {
                     t: tmax,
-                    inst: i,
+                    inst: entry.inst,
                     ..hit
                 };
             }
@@ -579,12 +645,11 @@ impl<I: Isa> LeafVisitor for TopQuery<'_, I> {
     #[inline(always)]
     fn any(&mut self, range: Range<usize>, tmax: f32) -> bool {
         let accel = self.accel;
-        for &i in &accel.tlas_items[range] {
-            let inst = &accel.instances[i as usize];
-            let Some((o, d, dt)) = self.enter(inst) else {
+        for entry in &accel.tlas_entries[range] {
+            let Some((o, d, dt)) = self.enter(entry) else {
                 continue;
             };
-            if accel.blases[inst.blas as usize].any::<I>(o, d, tmax - dt, self.tau) {
+            if accel.blases[entry.blas as usize].any::<I>(o, d, tmax - dt, self.tau) {
                 return true;
             }
         }
@@ -987,7 +1052,7 @@ mod tests {
             vec![Blas::build(&shape, None, BuildQuality::Medium)],
             vec![Instance {
                 blas: 0,
-                place: Place::Moving(motion),
+                place: Place::Moving(Box::new(motion)),
             }],
             BuildQuality::Medium,
         );

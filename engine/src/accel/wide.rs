@@ -492,6 +492,28 @@ impl WideBvh {
         total / root_area
     }
 
+    /// The boxes of the root's children, and of their children where a
+    /// child is a node: together they hold everything, in at most
+    /// `WIDTH`² boxes.
+    pub fn cover(&self) -> Vec<Aabb> {
+        let Some(root) = self.nodes.first() else {
+            return Vec::new();
+        };
+        let mut out = Vec::with_capacity(WIDTH * WIDTH);
+        for lane in 0..WIDTH {
+            let Some(aabb) = root.lane_box(lane) else {
+                continue;
+            };
+            if root.child[lane] & LEAF != 0 {
+                out.push(aabb);
+            } else {
+                let child = &self.nodes[root.child[lane] as usize];
+                out.extend((0..WIDTH).filter_map(|l| child.lane_box(l)));
+            }
+        }
+        out
+    }
+
     /// The box around everything, or `None` for an empty hierarchy.
     pub fn bounds(&self) -> Option<Aabb> {
         let root = self.nodes.first()?;

@@ -254,12 +254,12 @@ impl SceneGeometry {
     ) -> Result<Place, SceneError> {
         let outer = DMat4::from_translation(-self.render_origin) * copy.transform;
         match parts.pose.shutter {
-            Some((open, close)) if self.blur => Ok(Place::Moving(Motion {
+            Some((open, close)) if self.blur => Ok(Place::Moving(Box::new(Motion {
                 outer,
                 open,
                 close,
                 inner: parts.base,
-            })),
+            }))),
             _ => {
                 let m = outer * parts.pose.frame.matrix() * parts.base;
                 Placement::new(m).map(Place::Fixed).ok_or_else(|| {
