@@ -8,11 +8,14 @@
 //!
 //! * `deform`: the mesh deformed by a travelling, twisting wave, written
 //!   as an OBJ sequence of FRAMES frames (default 100) into a temporary
-//!   folder and rendered at 256×256, 16 spp, once per BVH update policy:
-//!   rebuilt every frame, refitted and rebuilt past SAH-cost thresholds of
-//!   1.1 to 2, refitted only. Per policy: BVH update and render time, the
-//!   SAH cost over the built cost, rays per second; plus the time of one
-//!   refit against one rebuild.
+//!   folder and rendered at 256×256, 16 spp, once per BVH update policy —
+//!   refitted and rebuilt past SAH-cost thresholds of 1.1, 1.3 and 2,
+//!   refitted only — each paired frame by frame with the same sequence
+//!   rebuilt every frame (rendered alternately, so the host's changing
+//!   speed falls on both alike). Per policy: BVH update and render time,
+//!   the SAH cost over the built cost, rays per second, render time over
+//!   the rebuilt sequence's; plus the time of one refit against one
+//!   rebuild.
 //! * `instances`: COUNT copies (default 10,000) of the mesh scattered over
 //!   a field against the mesh alone: memory in use after extract, and rays
 //!   per second rendering 256×256 at 16 spp. `instances-scene MESH.obj
@@ -36,8 +39,11 @@ fn resident_bytes() -> u64 {
         .map_or(0, |kb| kb * 1024)
 }
 
+/// A mesh's positions and triangles.
+type Mesh = (Vec<[f32; 3]>, Vec<[u32; 3]>);
+
 /// The mesh's positions and triangles.
-fn read_mesh(path: &Path) -> Result<(Vec<[f32; 3]>, Vec<[u32; 3]>)> {
+fn read_mesh(path: &Path) -> Result<Mesh> {
     let mesh = radiant::scene::obj::load_obj(path).map_err(anyhow::Error::msg)?;
     Ok((
         mesh.positions.iter().map(|p| p.to_array()).collect(),
@@ -74,8 +80,8 @@ fn write_deformed(
     let mut obj = String::with_capacity(positions.len() * 40 + triangles.len() * 30);
     for p in positions {
         let h = (p[1] - lo[1]) / (hi[1] - lo[1]).max(1e-6);
-        let wave = 0.06 * size * (std::f32::consts::TAU * (2.0 * h - 0.04 * t)).sin();
-        let twist = 1.2 * h * (0.07 * t).sin();
+        let wave = 0.12 * size * (std::f32::consts::TAU * (2.0 * h - 0.04 * t)).sin();
+        let twist = 2.0 * h * (0.05 * t).sin();
         let (s, c) = twist.sin_cos();
         let (x, z) = (p[0] - centre[0] + wave, p[2] - centre[1]);
         let _ = writeln!(
@@ -133,37 +139,69 @@ lights:
     )
 }
 
-/// What one run of a sequence measured.
+/// What a paired run measured: a sequence with a policy against the same
+/// sequence rebuilt every frame, frame by frame, rendered alternately so
+/// that the host's changing speed falls on both alike.
 #[derive(Default)]
-struct Run {
+struct Paired {
+    /// BVH update time, whole update time, render time and rays of the
+    /// policy's sequence.
     bvh: Duration,
+    update: Duration,
     render: Duration,
     rays: u64,
+    /// Render time of the sequence rebuilt every frame.
+    rebuilt_render: Duration,
+    /// Its BVH update time.
+    rebuilt_bvh: Duration,
     rebuilds: usize,
     worst_sah: f32,
     mean_sah: f64,
 }
 
-fn run_sequence(text: &str, dir: &Path, frames: u32, policy: UpdatePolicy) -> Result<Run> {
-    let mut scene = radiant::scene::from_str(text, &dir.join("bench.yaml"), dir)?;
+fn run_paired(text: &str, dir: &Path, frames: u32, policy: UpdatePolicy) -> Result<Paired> {
     let registry = radiant::builtin_registry();
-    let options = SequenceOptions {
-        policy,
+    let load = || radiant::scene::from_str(text, &dir.join("bench.yaml"), dir);
+    let (mut scene_a, mut scene_b) = (load()?, load()?);
+    let options = |rebuild_above| SequenceOptions {
+        policy: UpdatePolicy { rebuild_above },
         ..SequenceOptions::default()
     };
-    let (mut s, _) = Sequence::new(&mut scene, &registry, &Overrides::default(), &options, 1)?;
-    let mut run = Run::default();
+    let o = Overrides::default();
+    let (mut a, _) = Sequence::new(&mut scene_a, &registry, &o, &options(0.0), 1)?;
+    let (mut b, _) = Sequence::new(
+        &mut scene_b,
+        &registry,
+        &o,
+        &options(policy.rebuild_above),
+        1,
+    )?;
+    let mut run = Paired::default();
     for f in 1..=frames {
         if f > 1 {
-            let u = s.go_to(&mut scene, &registry, i64::from(f))?;
-            run.bvh += u.bvh;
-            run.rebuilds += u.geometry.rebuilt;
-            run.worst_sah = run.worst_sah.max(u.geometry.degradation);
-            run.mean_sah += f64::from(u.geometry.degradation) / f64::from(frames - 1);
+            let ua = a.go_to(&mut scene_a, &registry, i64::from(f))?;
+            let ub = b.go_to(&mut scene_b, &registry, i64::from(f))?;
+            run.rebuilt_bvh += ua.bvh;
+            run.bvh += ub.bvh;
+            run.update += ub.update;
+            run.rebuilds += ub.geometry.rebuilt;
+            run.worst_sah = run.worst_sah.max(ub.geometry.degradation);
+            run.mean_sah += f64::from(ub.geometry.degradation) / f64::from(frames - 1);
         }
-        let r = render(s.scene(), &Progress::none());
-        run.render += r.time;
-        run.rays += r.rays;
+        let time = |s: &Sequence| {
+            let r = render(s.scene(), &Progress::none());
+            (r.time, r.rays)
+        };
+        let ((ta, _), (tb, rays)) = if f % 2 == 0 {
+            let x = time(&a);
+            (x, time(&b))
+        } else {
+            let y = time(&b);
+            (time(&a), y)
+        };
+        run.rebuilt_render += ta;
+        run.render += tb;
+        run.rays += rays;
     }
     Ok(run)
 }
@@ -187,32 +225,42 @@ fn deform(mesh: &Path, frames: u32) -> Result<()> {
         triangles.len()
     );
     println!(
-        "policy (rebuild above)  rebuilds  BVH update  render     BVH share  Mrays/s  SAH mean/worst  render vs rebuilt"
+        "policy: rebuild above | rebuilds | BVH update | render | BVH share of frame | Mrays/s | SAH cost / built, mean and worst | render time / rebuilt every frame's"
     );
-    let mut rebuilt_render = None;
-    for above in [0.0f32, 1.1, 1.2, 1.3, 1.5, 2.0, f32::INFINITY] {
-        let policy = UpdatePolicy {
-            rebuild_above: above,
-        };
-        let r = run_sequence(&text, dir.path(), frames, policy)?;
-        let total = r.bvh + r.render;
-        let base = *rebuilt_render.get_or_insert(r.render.as_secs_f64());
-        let name = match above {
-            0.0 => "every frame".to_string(),
-            a if a.is_infinite() => "never (refit)".to_string(),
-            a => format!("{a}"),
+    for above in [1.1f32, 1.3, 2.0, f32::INFINITY] {
+        let r = run_paired(
+            &text,
+            dir.path(),
+            frames,
+            UpdatePolicy {
+                rebuild_above: above,
+            },
+        )?;
+        let frame = r.update + r.render;
+        let name = if above.is_infinite() {
+            "never (refit)".to_string()
+        } else {
+            format!("{above}")
         };
         println!(
-            "{name:<23} {:>8}  {:>8.2} s  {:>7.2} s  {:>8.2} %  {:>7.2}  {:>5.2}/{:<5.2}    {:.3}x",
+            "{name} | {} | {:.2} s | {:.2} s | {:.2} % | {:.2} | {:.3} / {:.3} | {:.3}",
             r.rebuilds,
             r.bvh.as_secs_f64(),
             r.render.as_secs_f64(),
-            100.0 * r.bvh.as_secs_f64() / total.as_secs_f64(),
+            100.0 * r.bvh.as_secs_f64() / frame.as_secs_f64(),
             r.rays as f64 / r.render.as_secs_f64() / 1e6,
             r.mean_sah,
             r.worst_sah,
-            r.render.as_secs_f64() / base
+            r.render.as_secs_f64() / r.rebuilt_render.as_secs_f64()
         );
+        if above == 1.1 {
+            let rebuilt_frame = r.rebuilt_bvh + r.rebuilt_render + r.update - r.bvh;
+            println!(
+                "(rebuilt every frame: BVH update {:.2} s, {:.2} % of its frame time)",
+                r.rebuilt_bvh.as_secs_f64(),
+                100.0 * r.rebuilt_bvh.as_secs_f64() / rebuilt_frame.as_secs_f64()
+            );
+        }
     }
     // One refit against one rebuild of the mesh's hierarchy.
     let prims = |f: u32| -> Result<Vec<radiant::accel::Primitive>> {

@@ -656,3 +656,34 @@ fn info_reports_the_animation() {
     );
     assert!(out.contains("instances    2 in the top level"), "{out}");
 }
+
+#[test]
+fn a_missing_frame_of_a_deforming_mesh_fails_before_any_frame_renders() {
+    let (dir, scene) = temp("mesh.yaml");
+    let grid = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    for f in [1, 2, 4] {
+        std::fs::write(dir.path().join(format!("m_{f}.obj")), grid).unwrap();
+    }
+    std::fs::write(
+        &scene,
+        "animation: {frames: [1, 4]}\nfilm: {width: 8, height: 8}\nsampler: {spp: 1}\n\
+         camera: {type: perspective, look_at: {origin: [0, 0, 4], target: [0, 0, 0]}}\n\
+         shapes:\n  - {type: mesh, filename: 'm_#.obj'}\n",
+    )
+    .unwrap();
+    let o = radiant(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--frames",
+        "1..4",
+        "-o",
+        dir.path().join("f_#.png").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert!(
+        err.contains("frame 3") && err.contains("m_3.obj") && err.contains(":6:"),
+        "{err}"
+    );
+    assert!(!dir.path().join("f_1.png").exists(), "a frame was written");
+}

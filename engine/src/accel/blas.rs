@@ -14,6 +14,7 @@ use super::{Hit, Primitive, ray_is_valid, sphere};
 use crate::settings::BuildQuality;
 use glam::{Vec3, Vec3A};
 use obvhs::aabb::Aabb;
+use rayon::prelude::*;
 use std::ops::Range;
 
 /// What a leaf holds: triangles four at a time, or one sphere.
@@ -92,6 +93,7 @@ impl Blas {
         policy: UpdatePolicy,
     ) -> Update {
         assert_eq!(prims.len(), self.order.len(), "the primitive count changed");
+        let start = std::time::Instant::now();
         let boxes = boxes(prims, close);
         let (mut order, mut packets) = (Vec::new(), Vec::new());
         let update = self.hierarchy.update(&boxes, policy, |leaf| {
@@ -104,9 +106,16 @@ impl Blas {
             // Same leaves, same order: repack the moved triangles.
             repack(&mut self.packets, prims, &self.order);
         }
-        self.prims = self.order.iter().map(|&i| prims[i as usize]).collect();
+        self.order
+            .par_iter()
+            .with_min_len(4096)
+            .map(|&i| prims[i as usize])
+            .collect_into_vec(&mut self.prims);
         self.closing = close.map(|close| closing(close, &self.order, &self.packets));
-        update
+        Update {
+            time: start.elapsed(),
+            ..update
+        }
     }
 
     /// Per leaf-order index, the index of the primitive in the input of the
@@ -226,11 +235,16 @@ impl Blas {
 /// The boxes of `prims` (containing their shapes at shutter close too).
 fn boxes(prims: &[Primitive], close: Option<&[Primitive]>) -> Vec<Option<Aabb>> {
     match close {
-        None => prims.iter().map(Primitive::aabb).collect(),
+        None => prims
+            .par_iter()
+            .with_min_len(4096)
+            .map(Primitive::aabb)
+            .collect(),
         Some(close) => {
             assert_eq!(close.len(), prims.len(), "open and close differ in length");
             prims
-                .iter()
+                .par_iter()
+                .with_min_len(4096)
                 .zip(close)
                 .map(|(a, b)| Some(a.aabb()?.union(&b.aabb()?)))
                 .collect()
@@ -288,8 +302,10 @@ fn pack(prims: impl Iterator<Item = Primitive>) -> Tri4 {
 /// Rewrites the triangle packets with the primitives' new shapes `prims`
 /// (input order), keeping the leaf order `order`.
 fn repack(packets: &mut [Packet], prims: &[Primitive], order: &[u32]) {
-    for packet in packets {
-        match packet {
+    packets
+        .par_iter_mut()
+        .with_min_len(1024)
+        .for_each(|packet| match packet {
             Packet::Triangles { tris, first, count } => {
                 let members = &order[*first as usize..(*first + *count) as usize];
                 *tris = pack(members.iter().map(|&i| prims[i as usize]));
@@ -303,8 +319,7 @@ fn repack(packets: &mut [Packet], prims: &[Primitive], order: &[u32]) {
                     (*centre, *radius) = (c, r);
                 }
             }
-        }
-    }
+        });
 }
 
 /// The packets of the shapes at shutter close `close` (input order),

@@ -13,6 +13,7 @@ use glam::Vec3A;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
+use rayon::prelude::*;
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
@@ -111,16 +112,23 @@ impl Hierarchy {
         let Some(cost) = self.cost else {
             return 1.0;
         };
-        let boxes = usable(boxes);
+        // Primitives without a finite box get a point box inside the scene.
+        let somewhere = boxes.iter().flatten().next().map_or(Vec3A::ZERO, |b| b.min);
+        let point = Aabb::new(somewhere, somewhere);
         let bvh2 = &mut self.bvh2;
-        for node in bvh2.nodes.iter_mut().filter(|n| n.is_leaf()) {
-            let first = node.first_index as usize;
-            let prims = &bvh2.primitive_indices[first..first + node.prim_count as usize];
-            let aabb = prims
-                .iter()
-                .fold(Aabb::empty(), |a, &p| a.union(&boxes[p as usize]));
-            node.set_aabb(aabb);
-        }
+        let indices = &bvh2.primitive_indices;
+        bvh2.nodes
+            .par_iter_mut()
+            .with_min_len(4096)
+            .filter(|n| n.is_leaf())
+            .for_each(|node| {
+                let first = node.first_index as usize;
+                let prims = &indices[first..first + node.prim_count as usize];
+                let aabb = prims.iter().fold(Aabb::empty(), |a, &p| {
+                    a.union(boxes[p as usize].as_ref().unwrap_or(&point))
+                });
+                node.set_aabb(aabb);
+            });
         bvh2.refit_all();
         self.wide.refit(bvh2);
         self.degradation_of(cost)

@@ -230,7 +230,7 @@ mod tests {
             // passes `p` (its origin moved forward a little).
             let origin = Vec3::new(5.0, 7.0, -3.0);
             let (o, d, dt) = x.ray_to_object(origin, q - origin);
-            assert!(dt >= 0.0 && dt < 1e-5, "{dt}");
+            assert!((0.0..1e-5).contains(&dt), "{dt}");
             let at = o + d * (1.0 - dt);
             assert!((at - p).length() < 1e-3, "{at} vs {p}");
         }

@@ -472,7 +472,7 @@ impl WideBvh {
             return 0.0;
         };
         let root_area = root.half_area();
-        if !(root_area > 0.0) {
+        if root_area.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return 0.0;
         }
         let mut total = root_area * NODE_COST;

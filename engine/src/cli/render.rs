@@ -163,6 +163,8 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
     let todo: Vec<i64> = (first..=last)
         .filter(|&f| !(args.skip_existing && frame_path(&args.output, f).exists()))
         .collect();
+    // Every deforming mesh's file is there before the first frame renders.
+    radiant::world::systems::check_mesh_files(&scene, &todo).map_err(report)?;
     let mut totals = Totals {
         skipped: (last - first + 1) as u64 - todo.len() as u64,
         ..Totals::default()

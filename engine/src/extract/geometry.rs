@@ -62,7 +62,10 @@ struct DynamicShape {
 /// What a frame's update of the geometry did.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct GeometryUpdate {
-    /// Time spent updating bottom and top levels.
+    /// Time spent on the geometry in all (placements, deforming meshes'
+    /// primitives and shading data, hierarchies).
+    pub total: Duration,
+    /// Of which refitting or rebuilding bottom levels and the top level.
     pub bvh: Duration,
     /// Bottom levels refitted and rebuilt.
     pub refitted: usize,
@@ -73,6 +76,20 @@ pub struct GeometryUpdate {
     pub degradation: f32,
     /// Whether the top level was rebuilt.
     pub top_rebuilt: bool,
+}
+
+/// What the first build of the geometry produced.
+pub(super) struct Built {
+    /// The state kept for later frames.
+    pub geometry: SceneGeometry,
+    /// The accelerator.
+    pub accel: Accel,
+    /// The shading data per primitive.
+    pub surfaces: Surfaces,
+    /// The material per instance ([`NO_MATERIAL`]: its primitives' own).
+    pub instance_material: Vec<u32>,
+    /// The shapes carrying emitters, with their light indices.
+    pub emitters: Vec<EmitterSource>,
 }
 
 /// The geometry's state across frames.
@@ -278,14 +295,13 @@ impl SceneGeometry {
     /// Builds the geometry of `scene` as it stands: the accelerator, the
     /// shading data, the per-instance materials and the emitter shapes
     /// (light indices from 0 in the order of the shapes).
-    #[allow(clippy::type_complexity)]
     pub(super) fn build(
         scene: &Scene,
         render_origin: DVec3,
         quality: Option<BuildQuality>,
         policy: UpdatePolicy,
         stats: &mut SceneStats,
-    ) -> Result<(Self, Accel, Surfaces, Vec<u32>, Vec<EmitterSource>), SceneError> {
+    ) -> Result<Built, SceneError> {
         let blur = scene.timeline.shutter.is_some();
         let mut geometry = Self {
             render_origin,
@@ -451,7 +467,13 @@ impl SceneGeometry {
         let top_quality = quality.unwrap_or_else(|| BuildQuality::default_for(instances.len()));
         let accel = Accel::new(blases, instances, top_quality);
         stats.bvh_build = accel.build_time;
-        Ok((geometry, accel, surfaces, instance_material, emitters))
+        Ok(Built {
+            geometry,
+            accel,
+            surfaces,
+            instance_material,
+            emitters,
+        })
     }
 
     /// The emitter shape of dynamic shape `entity` in render space at the
@@ -541,6 +563,7 @@ impl SceneGeometry {
                     let blas_index = d.blas;
                     let blas = accel.blas_mut(blas_index);
                     let update = blas.update(&geometric(&prims), closing.as_deref(), self.policy);
+                    report.bvh += update.time;
                     report.refitted += usize::from(!update.rebuilt);
                     report.rebuilt += usize::from(update.rebuilt);
                     report.degradation = report.degradation.max(update.degradation);
@@ -580,8 +603,9 @@ impl SceneGeometry {
         if changed {
             let top = accel.update_top_level(self.policy);
             report.top_rebuilt = top.rebuilt;
+            report.bvh += top.time;
         }
-        report.bvh = start.elapsed();
+        report.total = start.elapsed();
         Ok((moved, report))
     }
 

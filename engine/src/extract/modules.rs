@@ -514,6 +514,9 @@ fn build_emitter(
     Ok(light)
 }
 
+/// The lights of a frame and where each comes from.
+type BuiltLights = (Vec<Box<dyn Light>>, Vec<Source>);
+
 /// Builds every light: the emitters on shapes by their light index, then
 /// the free lights in the world's order.
 fn build_lights(
@@ -521,7 +524,7 @@ fn build_lights(
     textures: &mut TextureTable,
     named: &HashMap<String, TextureId>,
     mut emitters: Vec<EmitterSource>,
-) -> Result<(Vec<Box<dyn Light>>, Vec<Source>), SceneError> {
+) -> Result<BuiltLights, SceneError> {
     emitters.sort_by_key(|e| e.light);
     let mut lights = Vec::new();
     let mut sources = Vec::new();

@@ -179,7 +179,13 @@ pub(super) fn build(
         .w_axis
         .truncate();
     let mut stats = SceneStats::default();
-    let (geometry, accel, surfaces, instance_material, emitters) = SceneGeometry::build(
+    let super::geometry::Built {
+        geometry,
+        accel,
+        surfaces,
+        instance_material,
+        emitters,
+    } = SceneGeometry::build(
         scene,
         render_origin,
         overrides.bvh,

@@ -56,7 +56,7 @@ pub(crate) fn tessellate(
     let mut dropped = MeshRepairs::default();
     let mut push = |v: [Vec3; 3], n: [Vec3; 3], uv: [Vec2; 3]| {
         let normal = (v[1] - v[0]).cross(v[2] - v[0]);
-        if !keep_all && !(v.iter().all(|p| p.is_finite()) && normal.is_finite()) {
+        if !(keep_all || v.iter().all(|p| p.is_finite()) && normal.is_finite()) {
             dropped.non_finite += 1;
             return;
         }

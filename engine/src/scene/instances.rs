@@ -154,9 +154,9 @@ fn scatter_transforms(file: &Path, node: &Node) -> Result<Vec<DMat4>, SceneError
     let (min, max) = (DVec3::from(s.min), DVec3::from(s.max));
     let rotate = s.rotate.map_or([0.0, 0.0], |r| r.0);
     let scale = s.scale.map_or([1.0, 1.0], |r| r.0);
-    if !(min.cmple(max).all() && (min - max).is_finite())
-        || !(scale[0] > 0.0 && scale[1] >= scale[0])
-    {
+    let usable =
+        min.cmple(max).all() && (min - max).is_finite() && scale[0] > 0.0 && scale[1] >= scale[0];
+    if !usable {
         return Err(SceneError::new(
             file,
             loc(node.span()),

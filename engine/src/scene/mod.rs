@@ -439,7 +439,7 @@ impl Loader<'_> {
             let list = instances::parse_instances(file, n, &mut |m| {
                 parse_material_ref(self, Some(m), "an instance")
             })?;
-            if matches!(shape.sphere, true) && list.iter().any(|i| !is_similarity(i.transform)) {
+            if shape.sphere && list.iter().any(|i| !is_similarity(i.transform)) {
                 return Err(SceneError::new(
                     file,
                     loc(n.span()),

@@ -241,6 +241,48 @@ fn load_frame(
     Ok(Arc::new(mesh))
 }
 
+/// The files every deforming mesh reads for `frames` (with the frames
+/// around them that a shutter reaches), clamped to the timeline.
+fn sequence_frames(timeline: &Timeline, frames: &[i64]) -> Vec<i64> {
+    let mut needed: Vec<i64> = Vec::new();
+    for &f in frames {
+        let times = timeline.times(f);
+        let (open, close) = times.shutter.unwrap_or((times.time, times.time));
+        let lo = (open * timeline.fps).floor() as i64;
+        let hi = (close * timeline.fps).ceil() as i64;
+        needed.extend((lo..=hi).map(|g| g.clamp(timeline.start, timeline.end)));
+    }
+    needed.sort_unstable();
+    needed.dedup();
+    needed
+}
+
+/// Checks, before anything is rendered, that every file the deforming
+/// meshes read for `frames` exists.
+///
+/// # Errors
+///
+/// For the first missing file, at the mesh's `filename`.
+pub fn check_mesh_files(scene: &Scene, frames: &[i64]) -> Result<(), SceneError> {
+    let needed = sequence_frames(&scene.timeline, frames);
+    for sequence in scene.world.query::<&MeshSequence>().iter() {
+        for &f in &needed {
+            let path = sequence_path(&sequence.pattern, f);
+            if !path.is_file() {
+                return Err(SceneError::new(
+                    &scene.file,
+                    sequence.location,
+                    format!(
+                        "the deforming mesh's file for frame {f}, `{}`, does not exist",
+                        path.display()
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Writes the [`Geometry`] of every deforming mesh (a [`MeshSequence`]) at
 /// the frame — at shutter open where the shutter is open, with the mesh at
 /// shutter close in its [`ClosingMesh`].
