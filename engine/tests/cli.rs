@@ -666,7 +666,7 @@ fn a_missing_frame_of_a_deforming_mesh_fails_before_any_frame_renders() {
     }
     std::fs::write(
         &scene,
-        "animation: {frames: [1, 4]}\nfilm: {width: 8, height: 8}\nsampler: {spp: 1}\n\
+        "animation: {frames: [1, 4]}\nfilm: {width: 8, height: 8}\nsampler: {type: independent, spp: 1}\n\
          camera: {type: perspective, look_at: {origin: [0, 0, 4], target: [0, 0, 0]}}\n\
          shapes:\n  - {type: mesh, filename: 'm_#.obj'}\n",
     )
