@@ -36,6 +36,7 @@ import time
 RAYS = 1_000_000
 PASSES = 5
 PROBE_RE = re.compile(r"^\s+(closest|occluded):\s+([\d.]+) ns/ray")
+SCENE_RE = re.compile(r"^(\S.*): \d+ primitives")
 
 
 def load_obj(path):
@@ -118,15 +119,22 @@ def time_embree(triangles, rays):
 
 
 def time_probe(probe, args):
-    """[(closest, occluded) ns/ray] the probe reports, one pair per scene it
-    measures (the Cornell box first, then the mesh if `args` names one)."""
+    """{scene name: (closest, occluded) ns/ray} the probe reports for each
+    scene it measures (the Cornell box, directly and through a top level,
+    then the mesh if `args` names one)."""
     out = subprocess.run([probe, *args], capture_output=True, text=True, check=True).stdout
-    times = [m.group(1, 2) for m in map(PROBE_RE.match, out.splitlines()) if m]
-    pairs = []
-    for (q0, t0), (q1, t1) in zip(times[::2], times[1::2]):
-        assert (q0, q1) == ("closest", "occluded"), out
-        pairs.append((float(t0), float(t1)))
-    return pairs
+    scenes, name, times = {}, None, {}
+    for line in out.splitlines():
+        header = SCENE_RE.match(line)
+        if header:
+            name, times = header.group(1), {}
+            continue
+        m = PROBE_RE.match(line)
+        if m and name is not None:
+            times[m.group(1)] = float(m.group(2))
+            if len(times) == 2:
+                scenes[name] = (times["closest"], times["occluded"])
+    return scenes
 
 
 def report(name, triangles, rays, radiant):
@@ -163,12 +171,16 @@ def main():
           f"{'radiant ns':>10} {'radiant/embree':>15}")
     with tempfile.TemporaryDirectory() as tmp:
         obj = os.path.join(tmp, "cornell-box.obj")
-        cornell = time_probe(args.probe, ["--cornell-obj", obj])[0]
-        report("cornell-box", load_obj(obj), cornell_rays(rng), cornell)
+        probe = time_probe(args.probe, ["--cornell-obj", obj])
+        rays = cornell_rays(rng)
+        report("cornell-box", load_obj(obj), rays, probe["cornell box"])
+        report("cornell-box, top level", load_obj(obj), rays,
+               probe["cornell box through a top level"])
     for mesh in args.meshes:
         triangles = load_obj(mesh)
-        radiant = time_probe(args.probe, [mesh])[1]
-        report(mesh.rsplit("/", 1)[-1], triangles, mesh_rays(triangles, rng), radiant)
+        name = mesh.rsplit("/", 1)[-1]
+        radiant = time_probe(args.probe, [mesh])[name]
+        report(name, triangles, mesh_rays(triangles, rng), radiant)
     return 0
 
 
