@@ -495,12 +495,7 @@ impl Primitive {
 mod tests {
     use super::*;
 
-    fn lcg(state: &mut u64) -> f32 {
-        *state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*state >> 40) as f32 / (1u64 << 24) as f32
-    }
+    use crate::accel::tests::lcg;
 
     /// A grid of small triangles, and the same grid after a large,
     /// non-rigid move (a twist and a wave).

@@ -204,12 +204,7 @@ mod tests {
     use super::*;
     use glam::DQuat;
 
-    fn lcg(state: &mut u64) -> f32 {
-        *state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*state >> 40) as f32 / (1u64 << 24) as f32
-    }
+    use crate::accel::tests::lcg;
 
     #[test]
     fn rays_and_points_round_trip_within_their_error_bounds() {

@@ -519,18 +519,25 @@ impl Accel {
         if self.tlas.wide.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return Hit::MISS;
         }
-        let mut query = TopQuery {
+        let mut query = self.top_query::<I>(origin, dir, tau);
+        self.tlas
+            .wide
+            .closest::<I>(&RayBoxes::new(origin, dir), tmax, &mut query);
+        query.best
+    }
+
+    /// A query of the top level for the ray `origin + t·dir` at shutter
+    /// time `tau`.
+    #[inline(always)]
+    fn top_query<I: Isa>(&self, origin: Vec3, dir: Vec3, tau: f32) -> TopQuery<'_, I> {
+        TopQuery {
             accel: self,
             origin,
             dir,
             tau,
             best: Hit::MISS,
-            isa: PhantomData::<I>,
-        };
-        self.tlas
-            .wide
-            .closest::<I>(&RayBoxes::new(origin, dir), tmax, &mut query);
-        query.best
+            isa: PhantomData,
+        }
     }
 
     /// Whether anything is hit, with the instruction set `I`.
@@ -542,14 +549,7 @@ impl Accel {
         if self.tlas.wide.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return false;
         }
-        let mut query = TopQuery {
-            accel: self,
-            origin,
-            dir,
-            tau,
-            best: Hit::MISS,
-            isa: PhantomData::<I>,
-        };
+        let mut query = self.top_query::<I>(origin, dir, tau);
         self.tlas
             .wide
             .any::<I>(&RayBoxes::new(origin, dir), tmax, &mut query)
@@ -668,11 +668,13 @@ fn ray_is_valid(origin: Vec3, dir: Vec3, tmax: f32) -> bool {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use triangle::RayPrep;
 
-    fn lcg(state: &mut u64) -> f32 {
+    /// A small deterministic generator of uniform numbers in [0, 1), for
+    /// the accelerator's tests.
+    pub(crate) fn lcg(state: &mut u64) -> f32 {
         *state = state
             .wrapping_mul(6364136223846793005)
             .wrapping_add(1442695040888963407);

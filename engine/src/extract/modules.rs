@@ -113,7 +113,22 @@ impl Builder<'_> {
         shape: Option<&EmitterShape>,
         to_world: DMat4,
     ) -> Result<Box<T>, SceneError> {
+        self.build_as(spec, textures, named, shape, to_world, None)
+    }
+
+    /// [`Builder::build`], for named material `material` where it is one
+    /// (so that a material containing itself is caught).
+    fn build_as<T: ModuleType + ?Sized>(
+        &mut self,
+        spec: &ModuleSpec,
+        textures: &mut TextureTable,
+        named: &HashMap<String, TextureId>,
+        shape: Option<&EmitterShape>,
+        to_world: DMat4,
+        material: Option<usize>,
+    ) -> Result<Box<T>, SceneError> {
         let nested = NestedMaterials::new(self.registry, self.scene);
+        let _building = material.map(|i| nested.enter(i));
         let mut ctx = BuildContext {
             resolution: self.resolution,
             camera_to_render: self.camera_to_render,
@@ -460,31 +475,9 @@ fn build_material(
     textures: &mut TextureTable,
     named: &HashMap<String, TextureId>,
 ) -> Result<Box<dyn Shader>, SceneError> {
-    let spec = &b.scene.materials[i].1;
-    let nested = NestedMaterials::new(b.registry, b.scene);
-    let _building = nested.enter(i);
-    let mut ctx = BuildContext {
-        resolution: b.resolution,
-        camera_to_render: b.camera_to_render,
-        render_origin: b.render_origin,
-        seed: b.seed,
-        spp: b.spp,
-        emitter_shape: None,
-        to_world: DMat4::IDENTITY,
-        scene_sphere: b.sphere,
-        scene_dir: &b.scene.dir,
-        textures,
-        named_textures: named,
-        materials: Some(&nested),
-    };
-    let shader = b
-        .registry
-        .build::<dyn Shader>(&spec.type_name, &spec.params, &mut ctx)
-        .map_err(|e| module_error(&b.scene.file, spec, e))?;
-    b.modules
-        .insert((ModuleKind::Shader, spec.type_name.clone()));
-    b.modules.append(&mut nested.used.borrow_mut());
-    Ok(shader)
+    let scene = b.scene;
+    let spec = &scene.materials[i].1;
+    b.build_as::<dyn Shader>(spec, textures, named, None, DMat4::IDENTITY, Some(i))
 }
 
 /// Builds the area light `spec` on `shape`, checking that it is one.

@@ -45,16 +45,7 @@ fn y_up() -> Numbers<3> {
 impl LookAt {
     /// Mitsuba's look-at matrix: columns (left, up, forward, origin).
     pub(crate) fn matrix(&self) -> Option<DMat4> {
-        let origin = DVec3::from(self.origin);
-        let dir = (DVec3::from(self.target) - origin).try_normalize()?;
-        let left = DVec3::from(self.up).cross(dir).try_normalize()?;
-        let up = dir.cross(left);
-        Some(DMat4::from_cols(
-            left.extend(0.0),
-            up.extend(0.0),
-            dir.extend(0.0),
-            origin.extend(1.0),
-        ))
+        crate::world::systems::look_at(self.origin.into(), self.target.into(), self.up.into())
     }
 }
 
