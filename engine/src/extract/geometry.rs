@@ -149,8 +149,10 @@ fn lay_out(surfaces: &mut Surfaces, base: usize, order: &[u32], shading: &Shadin
                     Frame::from_normal(Vec3::Z)
                 };
             }
-            ShapePrim::Sphere { .. } => {
-                surfaces.normals[j] = [Vec3::ZERO; 3];
+            ShapePrim::Sphere { to_object, .. } => {
+                // A sphere has no vertex normals: the slot holds the rows
+                // of its rotation to object space (for its uv).
+                surfaces.normals[j] = to_object;
                 surfaces.uvs[j] = [Vec2::ZERO; 3];
                 surfaces.face_frames[j] = Frame::from_normal(Vec3::Z);
             }
@@ -164,7 +166,7 @@ fn geometric(prims: &[ShapePrim]) -> Vec<Primitive> {
         .iter()
         .map(|p| match *p {
             ShapePrim::Triangle { v, .. } => Primitive::Triangle(v),
-            ShapePrim::Sphere { centre, radius } => Primitive::Sphere(centre, radius),
+            ShapePrim::Sphere { centre, radius, .. } => Primitive::Sphere(centre, radius),
         })
         .collect()
 }
@@ -176,7 +178,7 @@ fn emitter_parts(prims: &[ShapePrim]) -> (Vec<u32>, EmitterShape) {
     for p in prims {
         match *p {
             ShapePrim::Triangle { v, .. } => shape.triangles.push(v),
-            ShapePrim::Sphere { centre, radius } => shape.spheres.push((centre, radius)),
+            ShapePrim::Sphere { centre, radius, .. } => shape.spheres.push((centre, radius)),
         }
     }
     let tris = shape.triangles.len() as u32;
@@ -208,7 +210,7 @@ fn prims_box(prims: &[ShapePrim]) -> Option<(Vec3, Vec3)> {
                     hi = hi.max(x);
                 }
             }
-            ShapePrim::Sphere { centre, radius } => {
+            ShapePrim::Sphere { centre, radius, .. } => {
                 lo = lo.min(centre - radius);
                 hi = hi.max(centre + radius);
             }

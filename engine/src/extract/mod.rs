@@ -62,7 +62,10 @@ pub struct Surfaces {
     /// Index of the primitive within its emitter's shape.
     pub emitter_prim: Vec<u32>,
     /// Vertex normals of triangles (all zero: use the face normal), in the
-    /// primitive's own space.
+    /// primitive's own space; for spheres, the rows of the rotation from
+    /// that space to the sphere's object space, where its texture
+    /// coordinates are defined (Mitsuba 3's: u = atan2(y, x)/2π, v =
+    /// acos(z)/π).
     pub normals: Vec<[Vec3; 3]>,
     /// Vertex texture coordinates of triangles.
     pub uvs: Vec<[Vec2; 3]>,

@@ -18,19 +18,64 @@ pub(crate) enum ShapePrim {
         n: [Vec3; 3],
         uv: [Vec2; 3],
     },
-    /// A sphere.
-    Sphere { centre: Vec3, radius: f32 },
+    /// A sphere, with the rotation from render space to its object space
+    /// (rows), where its texture coordinates are defined.
+    Sphere {
+        centre: Vec3,
+        radius: f32,
+        to_object: [Vec3; 3],
+    },
 }
 
-/// Face `normal` with tangent axes (u, v) such that u × v = normal.
-const CUBE_FACES: [(DVec3, DVec3, DVec3); 6] = [
-    (DVec3::X, DVec3::Y, DVec3::Z),
-    (DVec3::NEG_X, DVec3::Z, DVec3::Y),
-    (DVec3::Y, DVec3::Z, DVec3::X),
-    (DVec3::NEG_Y, DVec3::X, DVec3::Z),
-    (DVec3::Z, DVec3::X, DVec3::Y),
-    (DVec3::NEG_Z, DVec3::Y, DVec3::X),
+/// The cube's faces as Mitsuba 3's `cube` lays them out: corners a, b, c,
+/// d (counter-clockwise seen from outside) with texture coordinates
+/// (0, 1), (1, 1), (1, 0), (0, 0), in Mitsuba's order of faces (−y, +y,
+/// +x, +z, −x, −z).
+const CUBE_FACES: [[[f64; 3]; 4]; 6] = [
+    [
+        [1.0, -1.0, -1.0],
+        [1.0, -1.0, 1.0],
+        [-1.0, -1.0, 1.0],
+        [-1.0, -1.0, -1.0],
+    ],
+    [
+        [1.0, 1.0, -1.0],
+        [-1.0, 1.0, -1.0],
+        [-1.0, 1.0, 1.0],
+        [1.0, 1.0, 1.0],
+    ],
+    [
+        [1.0, -1.0, -1.0],
+        [1.0, 1.0, -1.0],
+        [1.0, 1.0, 1.0],
+        [1.0, -1.0, 1.0],
+    ],
+    [
+        [1.0, -1.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [-1.0, 1.0, 1.0],
+        [-1.0, -1.0, 1.0],
+    ],
+    [
+        [-1.0, -1.0, 1.0],
+        [-1.0, 1.0, 1.0],
+        [-1.0, 1.0, -1.0],
+        [-1.0, -1.0, -1.0],
+    ],
+    [
+        [1.0, 1.0, -1.0],
+        [1.0, -1.0, -1.0],
+        [-1.0, -1.0, -1.0],
+        [-1.0, 1.0, -1.0],
+    ],
 ];
+
+/// The texture coordinates of a cube face's corners a, b, c, d.
+const CUBE_UVS: [Vec2; 4] = [Vec2::Y, Vec2::ONE, Vec2::X, Vec2::ZERO];
+
+/// The texture coordinates of the rectangle's corners (−1, −1), (1, −1),
+/// (1, 1), (−1, 1): Mitsuba 3's ((x + 1)/2, (y + 1)/2).
+const RECTANGLE_UVS: [Vec2; 4] = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
 
 /// Tessellates `geometry` under `to_world`, then shifts it so that
 /// `render_origin` becomes the origin, appending to `out`. With `flip`, the
@@ -75,13 +120,15 @@ pub(crate) fn tessellate(
             ShapePrim::Triangle { v, n, uv }
         });
     };
-    let quad = |push: &mut dyn FnMut([Vec3; 3], [Vec3; 3], [Vec2; 3]), c: [DVec3; 4]| {
-        let p = c.map(point);
-        let uv = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
-        let flat = [Vec3::ZERO; 3];
-        push([p[0], p[1], p[2]], flat, [uv[0], uv[1], uv[2]]);
-        push([p[0], p[2], p[3]], flat, [uv[0], uv[2], uv[3]]);
-    };
+    // A quad (a, b, c, d) as the triangles (a, b, c) and (a, c, d), the
+    // pair area lights recognise as a rectangle.
+    let quad =
+        |push: &mut dyn FnMut([Vec3; 3], [Vec3; 3], [Vec2; 3]), c: [DVec3; 4], uv: [Vec2; 4]| {
+            let p = c.map(point);
+            let flat = [Vec3::ZERO; 3];
+            push([p[0], p[1], p[2]], flat, [uv[0], uv[1], uv[2]]);
+            push([p[0], p[2], p[3]], flat, [uv[0], uv[2], uv[3]]);
+        };
     match geometry {
         Geometry::Rectangle => quad(
             &mut push,
@@ -91,17 +138,27 @@ pub(crate) fn tessellate(
                 DVec3::new(1.0, 1.0, 0.0),
                 DVec3::new(-1.0, 1.0, 0.0),
             ],
+            RECTANGLE_UVS,
         ),
         Geometry::Cube => {
-            for (n, u, v) in CUBE_FACES {
-                quad(&mut push, [n - u - v, n + u - v, n + u + v, n - u + v]);
+            for face in CUBE_FACES {
+                quad(&mut push, face.map(DVec3::from), CUBE_UVS);
             }
         }
         Geometry::Sphere => {
             debug_assert!(!flip, "the scene loader rejects flipped spheres");
             let centre = point(DVec3::ZERO);
-            let radius = to_world.transform_vector3(DVec3::X).length() as f32;
-            out.push(ShapePrim::Sphere { centre, radius });
+            let scale = to_world.transform_vector3(DVec3::X).length();
+            // The transform is a similarity (the loader checks): its
+            // linear part over its scale is orthogonal, and its inverse
+            // is its transpose, whose rows are its columns.
+            let r = DMat3::from_mat4(to_world) / scale;
+            let to_object = [r.x_axis, r.y_axis, r.z_axis].map(|c| c.as_vec3());
+            out.push(ShapePrim::Sphere {
+                centre,
+                radius: scale as f32,
+                to_object,
+            });
         }
         Geometry::Mesh(mesh) => {
             for t in &mesh.triangles {

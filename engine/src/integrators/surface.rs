@@ -119,9 +119,12 @@ fn local_interaction(
             let n = (raw - centre).normalize();
             // Re-project onto the surface to shrink the error.
             let p = centre + n * radius;
+            // Texture coordinates in the sphere's object space (Mitsuba 3's).
+            let [r0, r1, r2] = scene.surfaces.normals[i];
+            let local = Vec3::new(r0.dot(n), r1.dot(n), r2.dot(n));
             let uv = Vec2::new(
-                (n.y.atan2(n.x) * std::f32::consts::FRAC_1_PI * 0.5).rem_euclid(1.0),
-                n.z.clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI,
+                (local.y.atan2(local.x) * std::f32::consts::FRAC_1_PI * 0.5).rem_euclid(1.0),
+                local.z.clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI,
             );
             Interaction {
                 p,

@@ -83,7 +83,7 @@ struct Loader<'f> {
     material_ids: HashMap<String, u32>,
     /// Deforming meshes whose first frame is read once the frame range is
     /// known: (entity, pattern, where `filename` was written).
-    sequences: Vec<(hecs::Entity, PathBuf, Option<Location>)>,
+    sequences: Vec<(hecs::Entity, PendingSequence)>,
 }
 
 /// Parses scene text; `file` names it in errors and `dir` resolves
@@ -450,22 +450,28 @@ impl Loader<'_> {
                 .insert_one(entity, Instances(Arc::from(list)))
                 .expect(spawned);
         }
-        if let Some((pattern, at)) = shape.sequence {
-            self.sequences.push((entity, pattern, at));
+        if let Some(pending) = shape.sequence {
+            self.sequences.push((entity, pending));
         }
         Ok(())
     }
 
     /// Reads the first frame of every deforming mesh.
     fn read_sequences(&mut self, world: &mut World, timeline: &Timeline) -> Result<(), SceneError> {
-        for (entity, pattern, at) in self.sequences.drain(..) {
+        for (entity, pending) in self.sequences.drain(..) {
+            let PendingSequence {
+                pattern,
+                location,
+                flip_tex_coords,
+            } = pending;
             let path = crate::world::systems::sequence_path(&pattern, timeline.start);
-            let first =
-                obj::load_obj_frame(&path).map_err(|m| SceneError::new(self.file, at, m))?;
+            let first = obj::load_obj_frame(&path, flip_tex_coords)
+                .map_err(|m| SceneError::new(self.file, location, m))?;
             let first = Arc::new(first);
             let sequence = MeshSequence {
                 pattern,
-                location: at,
+                location,
+                flip_tex_coords,
                 topology: first.clone(),
             };
             world
@@ -700,9 +706,20 @@ struct ShapeDef {
     flip_normals: bool,
     /// Whether the shape is a sphere.
     sphere: bool,
-    /// For a deforming mesh: its file name pattern (resolved) and where
-    /// it was written.
-    sequence: Option<(PathBuf, Option<Location>)>,
+    /// For a deforming mesh: its frames, to read once the frame range is
+    /// known.
+    sequence: Option<PendingSequence>,
+}
+
+/// A deforming mesh whose first frame is read once the frame range is
+/// known.
+struct PendingSequence {
+    /// The file name pattern, resolved against the scene's folder.
+    pattern: PathBuf,
+    /// Where `filename` was written.
+    location: Option<Location>,
+    /// Whether texture coordinates are read as (u, 1 − v).
+    flip_tex_coords: bool,
 }
 
 #[derive(Deserialize)]
@@ -800,15 +817,35 @@ fn parse_shape(loader: &mut Loader<'_>, node: &Node, index: usize) -> Result<Sha
                     ));
                 }
             };
+            let flip_tex_coords = match map.get("flip_tex_coords") {
+                None => true,
+                Some(n) => n.as_scalar().and_then(|s| s.as_bool()).ok_or_else(|| {
+                    SceneError::new(
+                        file,
+                        loc(n.span()),
+                        "`flip_tex_coords` must be true or false",
+                    )
+                })?,
+            };
             if filename.contains('#') {
                 // A deforming mesh: its frames are read once the frame
                 // range is known; until then, an empty mesh.
-                sequence = Some((dir.join(&filename), file_loc));
-                (Geometry::Mesh(Arc::default()), &["filename"])
+                sequence = Some(PendingSequence {
+                    pattern: dir.join(&filename),
+                    location: file_loc,
+                    flip_tex_coords,
+                });
+                (
+                    Geometry::Mesh(Arc::default()),
+                    &["filename", "flip_tex_coords"],
+                )
             } else {
-                let mesh = obj::load_obj(&dir.join(&filename))
+                let mesh = obj::load_obj(&dir.join(&filename), flip_tex_coords)
                     .map_err(|msg| SceneError::new(file, file_loc, msg))?;
-                (Geometry::Mesh(Arc::new(mesh)), &["filename"])
+                (
+                    Geometry::Mesh(Arc::new(mesh)),
+                    &["filename", "flip_tex_coords"],
+                )
             }
         }
         other => {

@@ -14,8 +14,11 @@ use glam::{DVec3, Vec2, Vec3};
 use std::path::Path;
 
 /// Loads every object of an OBJ file into one mesh (materials are ignored).
-pub fn load_obj(path: &Path) -> Result<MeshData, String> {
-    let mut mesh = read_obj(path)?;
+/// With `flip_tex_coords` (Mitsuba 3's default), texture coordinates are
+/// stored as (u, 1 − v): OBJ's v runs up an image, Radiant's (Mitsuba's)
+/// runs down it, so an image made for the OBJ appears upright.
+pub fn load_obj(path: &Path, flip_tex_coords: bool) -> Result<MeshData, String> {
+    let mut mesh = read_obj(path, flip_tex_coords)?;
     repair(&mut mesh);
     if mesh.triangles.is_empty() {
         return Err(format!(
@@ -32,8 +35,8 @@ pub fn load_obj(path: &Path) -> Result<MeshData, String> {
 /// triangle is kept, degenerate or not, so that all frames of a sequence
 /// have the same triangles (a triangle of zero area is never hit, one
 /// with non-finite vertices neither).
-pub fn load_obj_frame(path: &Path) -> Result<MeshData, String> {
-    let mut mesh = read_obj(path)?;
+pub fn load_obj_frame(path: &Path, flip_tex_coords: bool) -> Result<MeshData, String> {
+    let mut mesh = read_obj(path, flip_tex_coords)?;
     repair_attributes(&mut mesh);
     if mesh.triangles.is_empty() {
         return Err(format!("mesh file `{}` has no triangles", path.display()));
@@ -76,8 +79,9 @@ pub fn check_topology(first: &MeshData, mesh: &MeshData) -> Result<(), String> {
     Ok(())
 }
 
-/// Reads every object of an OBJ file into one mesh, unrepaired.
-fn read_obj(path: &Path) -> Result<MeshData, String> {
+/// Reads every object of an OBJ file into one mesh, unrepaired (texture
+/// coordinates as (u, 1 − v) with `flip_tex_coords`).
+fn read_obj(path: &Path, flip_tex_coords: bool) -> Result<MeshData, String> {
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -112,7 +116,12 @@ fn read_obj(path: &Path) -> Result<MeshData, String> {
             );
         }
         if all_have_uvs {
-            uvs.extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])));
+            let v = |v: f32| if flip_tex_coords { 1.0 - v } else { v };
+            uvs.extend(
+                m.texcoords
+                    .chunks_exact(2)
+                    .map(|t| Vec2::new(t[0], v(t[1]))),
+            );
         }
         mesh.triangles.extend(
             m.indices
@@ -203,7 +212,7 @@ mod tests {
              f 1//1 2//2 3//3\nf 1//1 4//4 3//3\nf 1//1 2//2 5//5\nf 1//1 1//1 3//3\n"
         )
         .unwrap();
-        let mesh = load_obj(f.path()).unwrap();
+        let mesh = load_obj(f.path(), true).unwrap();
         assert_eq!(mesh.triangles.len(), 1);
         assert_eq!(mesh.repairs.non_finite, 1);
         assert_eq!(
@@ -216,7 +225,7 @@ mod tests {
 
     #[test]
     fn missing_file_is_an_error() {
-        let err = load_obj(Path::new("/nonexistent/mesh.obj")).unwrap_err();
+        let err = load_obj(Path::new("/nonexistent/mesh.obj"), true).unwrap_err();
         assert!(err.contains("cannot open"), "{err}");
     }
 }

@@ -259,6 +259,8 @@ pub struct MeshSequence {
     pub pattern: PathBuf,
     /// Where `filename` was written.
     pub location: Option<Location>,
+    /// Whether texture coordinates are read as (u, 1 − v).
+    pub flip_tex_coords: bool,
     /// The first frame's mesh: every frame must have its triangles.
     pub topology: Arc<MeshData>,
 }

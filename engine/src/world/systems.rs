@@ -236,7 +236,7 @@ fn load_frame(
 ) -> Result<Arc<MeshData>, SceneError> {
     let path = sequence_path(&sequence.pattern, frame);
     let at = |message: String| SceneError::new(scene_file, sequence.location, message);
-    let mesh = crate::scene::obj::load_obj_frame(&path).map_err(at)?;
+    let mesh = crate::scene::obj::load_obj_frame(&path, sequence.flip_tex_coords).map_err(at)?;
     crate::scene::obj::check_topology(&sequence.topology, &mesh).map_err(at)?;
     Ok(Arc::new(mesh))
 }

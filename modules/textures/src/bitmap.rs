@@ -1,10 +1,12 @@
 //! The `image` texture: an image file looked up with bilinear (or nearest)
 //! filtering and a wrap mode.
 //!
-//! Texture space: (u, v) = (0, 0) is the image's bottom-left corner and
-//! (1, 1) its top-right (the OBJ convention, so images appear upright on
-//! meshes and on the `rectangle` shape); texel (i, j) of a w × h image,
-//! row j counted from the top, has its centre at ((i + ½)/w, 1 − (j + ½)/h).
+//! Texture space is Mitsuba 3's: (u, v) = (0, 0) is the image's top-left
+//! corner, u runs to the right and v down the image; texel (i, j) of a
+//! w × h image, row j counted from the top, has its centre at
+//! ((i + ½)/w, (j + ½)/h). (Meshes read from OBJ files store 1 − v, as
+//! Mitsuba's loader does, so an image laid out for OBJ's bottom-up v
+//! appears upright on them.)
 //!
 //! No mipmaps: the integrator does not track ray footprints, so lookups
 //! are point samples of the bilinear reconstruction. A minified texture is
@@ -73,7 +75,7 @@ impl ImageTexture {
         // Continuous texel coordinates, rows from the top, kept finite and
         // far from i64's limits so that the neighbour indices cannot overflow.
         let x = texel_coordinate(uv.x * self.texels.width as f32);
-        let y = texel_coordinate((1.0 - uv.y) * self.texels.height as f32);
+        let y = texel_coordinate(uv.y * self.texels.height as f32);
         match self.filtering {
             Filtering::Nearest => self.texel(x.floor() as i64, y.floor() as i64),
             Filtering::Bilinear => {
@@ -156,7 +158,7 @@ pub(crate) fn register(registry: &mut Registry) {
     registry.register::<dyn Texture>(
         ModuleInfo {
             type_name: "image",
-            summary: "Image file with bilinear filtering; (0, 0) is the bottom-left corner.",
+            summary: "Image file with bilinear filtering; (0, 0) is the top-left corner (Mitsuba 3).",
             params: DOCS,
         },
         |params: &Params, ctx: &mut BuildContext<'_>| {

@@ -73,9 +73,10 @@ fn raw(c: [u8; 3]) -> Rgb {
     Rgb::from_array(c.map(|x| x as f32 / 255.0))
 }
 
-/// The centre of texel (i, j), row j from the top, of a 4×2 image.
+/// The centre of texel (i, j), row j from the top, of a 4×2 image
+/// (Mitsuba 3's texture space: v runs down the image).
 fn centre(i: usize, j: usize) -> (f32, f32) {
-    ((i as f32 + 0.5) / 4.0, 1.0 - (j as f32 + 0.5) / 2.0)
+    ((i as f32 + 0.5) / 4.0, (j as f32 + 0.5) / 2.0)
 }
 
 fn close(a: Rgb, b: Rgb, tol: f32) -> bool {
@@ -128,9 +129,10 @@ fn bilinear_interpolates_between_centres_and_nearest_does_not() {
     let got = s.at(t, 0.5, 0.5);
     let avg = (c(1, 0) + c(2, 0) + c(1, 1) + c(2, 1)) * 0.25;
     assert!(close(got, avg, 1e-6), "{got} vs {avg}");
-    // Nearest: the texel the point is in, however close to an edge.
-    assert!(close(s.at(n, 0.499, 0.501), c(1, 0), 0.0));
-    assert!(close(s.at(n, 0.501, 0.499), c(2, 1), 0.0));
+    // Nearest: the texel the point is in, however close to an edge (v
+    // runs down the image: v < 0.5 is the top row).
+    assert!(close(s.at(n, 0.499, 0.499), c(1, 0), 0.0));
+    assert!(close(s.at(n, 0.501, 0.501), c(2, 1), 0.0));
 }
 
 #[test]
@@ -160,8 +162,8 @@ fn wrap_modes_repeat_clamp_and_mirror() {
             assert!(close(s.at(*m, u, v), want, 0.0), "mode {m:?} u {u}");
         }
     }
-    // Mirroring in v: just above the top edge reads the top row.
-    assert!(close(s.at(modes[2], 0.125, 1.2), c(0, 0), 0.0));
+    // Mirroring in v: just above the top edge (v < 0) reads the top row.
+    assert!(close(s.at(modes[2], 0.125, -0.2), c(0, 0), 0.0));
     // Bilinear + repeat blends across the seam; clamp does not.
     let r = s.add("r", "image", "filename: texels-4x2.png").unwrap();
     let k = s
