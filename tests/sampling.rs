@@ -38,16 +38,13 @@ fn diffuse_sampling_matches_its_pdf_at_every_incidence() {
         let uvs = vec![Vec2::ZERO; n];
         let mut out = vec![BsdfSample::default(); n];
         let mut ctx = ShadeContext::new(&textures);
-        shader.sample(&mut ctx, SurfaceBatch { wo: &wos, uv: &uvs }, &u, &mut out);
+        shader.sample(&mut ctx, SurfaceBatch::new(&wos, &uvs), &u, &mut out);
         let pdf = |wi: Vec3| {
             let mut e = [BsdfEval::default()];
             let mut ctx = ShadeContext::new(&textures);
             shader.eval(
                 &mut ctx,
-                SurfaceBatch {
-                    wo: &[wo],
-                    uv: &[Vec2::ZERO],
-                },
+                SurfaceBatch::new(&[wo], &[Vec2::ZERO]),
                 &[wi],
                 &mut e,
             );
@@ -357,10 +354,7 @@ fn the_test_rejects_a_wrong_pdf() {
     let mut ctx = ShadeContext::new(&textures);
     shader.sample(
         &mut ctx,
-        SurfaceBatch {
-            wo: &vec![Vec3::Z; n],
-            uv: &vec![Vec2::ZERO; n],
-        },
+        SurfaceBatch::new(&vec![Vec3::Z; n], &vec![Vec2::ZERO; n]),
         &u,
         &mut out,
     );

@@ -2,11 +2,17 @@
 //! exactly as a scene builds them (with two test textures and inline
 //! nested materials), evaluated one direction at a time; and the zoom map
 //! that lets the chi-square test resolve very narrow lobes.
+//!
+//! Shaders that ask for [`Effects::TANGENT_FRAMES`] get surface
+//! derivatives [`DP_DU`] and [`DP_DV`] that are neither unit, orthogonal
+//! to each other, nor in the tangent plane, as on a curved, sheared
+//! parametrization, so that the sampling and energy tests exercise the
+//! frames that wrappers build from them.
 
 use glam::{DVec3, UVec2, Vec2, Vec3};
 use radiant_core::registry::Registry;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Frame, MaterialSource, ParamError, Params, Rgb,
+    BsdfEval, BsdfSample, BuildContext, Effects, Frame, MaterialSource, ParamError, Params, Rgb,
     ShadeContext, Shader, SurfaceBatch, Texture, TextureTable,
 };
 use std::collections::HashMap;
@@ -14,6 +20,13 @@ use std::path::Path;
 
 /// The texture coordinates every test point has.
 pub const UV: Vec2 = Vec2::new(0.3, 0.6);
+
+/// ∂p/∂u of every test point (local frame), for shaders with
+/// [`Effects::TANGENT_FRAMES`].
+pub const DP_DU: Vec3 = Vec3::new(-1.1, 1.3, 0.4);
+
+/// ∂p/∂v likewise.
+pub const DP_DV: Vec3 = Vec3::new(-0.5, -0.2, -0.15);
 
 /// A smooth height field, h = 0.3 sin(6u) + 0.2 v, named `ramp` in tests
 /// (for `bump`).
@@ -111,9 +124,10 @@ impl TestShader {
         let wos = vec![wo; n];
         let uvs = vec![UV; n];
         let mut out = vec![BsdfSample::default(); n];
+        let (du, dv) = (vec![DP_DU; n], vec![DP_DV; n]);
         let mut ctx = ShadeContext::new(&self.textures);
-        self.shader
-            .sample(&mut ctx, SurfaceBatch { wo: &wos, uv: &uvs }, u, &mut out);
+        let surface = self.surface(&wos, &uvs, &du, &dv);
+        self.shader.sample(&mut ctx, surface, u, &mut out);
         out
     }
 
@@ -121,16 +135,31 @@ impl TestShader {
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> BsdfEval {
         let mut out = [BsdfEval::default()];
         let mut ctx = ShadeContext::new(&self.textures);
-        self.shader.eval(
-            &mut ctx,
-            SurfaceBatch {
-                wo: &[wo],
-                uv: &[UV],
-            },
-            &[wi],
-            &mut out,
-        );
+        let wo = [wo];
+        let surface = self.surface(&wo, &[UV], &[DP_DU], &[DP_DV]);
+        self.shader.eval(&mut ctx, surface, &[wi], &mut out);
         out[0]
+    }
+
+    /// The batch of points seen from `wo` at `uv`, with the derivatives
+    /// where the shader asks for them.
+    fn surface<'a>(
+        &self,
+        wo: &'a [Vec3],
+        uv: &'a [Vec2],
+        dp_du: &'a [Vec3],
+        dp_dv: &'a [Vec3],
+    ) -> SurfaceBatch<'a> {
+        if self.shader.effects().contains(Effects::TANGENT_FRAMES) {
+            SurfaceBatch {
+                wo,
+                uv,
+                dp_du,
+                dp_dv,
+            }
+        } else {
+            SurfaceBatch::new(wo, uv)
+        }
     }
 }
 

@@ -81,6 +81,13 @@ impl Placement {
         Vec3::from(self.normals * Vec3A::from(n)).normalize_or_zero()
     }
 
+    /// Object-space vector `v` (a tangent, a surface derivative) in render
+    /// space, scaled by the transform.
+    #[inline]
+    pub fn vector_to_render(&self, v: Vec3) -> Vec3 {
+        Vec3::from(self.to_render.matrix3 * Vec3A::from(v))
+    }
+
     /// The render-space box around object-space box `b`.
     pub fn bounds(&self, b: &Aabb) -> Aabb {
         let mut out = Aabb::empty();

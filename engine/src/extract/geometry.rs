@@ -133,15 +133,25 @@ fn lay_out(surfaces: &mut Surfaces, base: usize, order: &[u32], shading: &Shadin
             .face_frames
             .resize(end, Frame::from_normal(Vec3::Z));
     }
+    let has_tangents = shading
+        .prims
+        .iter()
+        .any(|p| matches!(p, ShapePrim::Triangle { t, .. } if t[0] != Vec3::ZERO));
+    if (has_tangents || !surfaces.tangents.is_empty()) && surfaces.tangents.len() < end {
+        surfaces.tangents.resize(end, [Vec3::ZERO; 3]);
+    }
     for (k, &i) in order.iter().enumerate() {
         let (j, i) = (base + k, i as usize);
         surfaces.material[j] = shading.material[i];
         surfaces.emitter[j] = shading.emitter[i];
         surfaces.emitter_prim[j] = shading.emitter_prim[i];
         match shading.prims[i] {
-            ShapePrim::Triangle { v, n, uv } => {
+            ShapePrim::Triangle { v, n, uv, t } => {
                 surfaces.normals[j] = n;
                 surfaces.uvs[j] = uv;
+                if let Some(slot) = surfaces.tangents.get_mut(j) {
+                    *slot = t;
+                }
                 let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
                 surfaces.face_frames[j] = if shading.render_space {
                     Frame::from_normal(ng)

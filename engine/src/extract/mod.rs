@@ -30,6 +30,7 @@ mod sequence;
 mod shapes;
 
 pub use lights::LightTable;
+pub(crate) use shapes::BARYCENTRIC_UVS;
 pub use sequence::{FrameUpdate, Sequence, SequenceOptions};
 
 use crate::accel::{Accel, Hit, Motion};
@@ -69,6 +70,10 @@ pub struct Surfaces {
     pub normals: Vec<[Vec3; 3]>,
     /// Vertex texture coordinates of triangles.
     pub uvs: Vec<[Vec2; 3]>,
+    /// Vertex tangents of triangles (MikkTSpace, in the primitive's own
+    /// space; all zero: take ∂p/∂u of the face). Empty where no shape has
+    /// any.
+    pub tangents: Vec<[Vec3; 3]>,
     /// Frame around the unit face normal of triangles in render space (by
     /// winding), made once here rather than at every hit; `n` is the
     /// geometric normal. (Primitives of placed instances make theirs at

@@ -11,12 +11,14 @@ use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};
 /// One primitive with its shading attributes, in render space.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum ShapePrim {
-    /// A triangle with per-vertex normals (zero = use the face normal) and
-    /// texture coordinates.
+    /// A triangle with per-vertex normals (zero = use the face normal),
+    /// texture coordinates and tangents (zero = none: shading takes ∂p/∂u
+    /// of the face).
     Triangle {
         v: [Vec3; 3],
         n: [Vec3; 3],
         uv: [Vec2; 3],
+        t: [Vec3; 3],
     },
     /// A sphere, with the rotation from render space to its object space
     /// (rows), where its texture coordinates are defined.
@@ -77,6 +79,12 @@ const CUBE_UVS: [Vec2; 4] = [Vec2::Y, Vec2::ONE, Vec2::X, Vec2::ZERO];
 /// (1, 1), (−1, 1): Mitsuba 3's ((x + 1)/2, (y + 1)/2).
 const RECTANGLE_UVS: [Vec2; 4] = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
 
+/// The texture coordinates of every triangle of a mesh without any: the
+/// barycentric coordinates (b₁, b₂) of the hit, as in Mitsuba 3. They are
+/// no parametrization of the surface: shading frames there turn about the
+/// z axis ([`Frame::around_z`](radiant_core::Frame::around_z)).
+pub(crate) const BARYCENTRIC_UVS: [Vec2; 3] = [Vec2::ZERO, Vec2::X, Vec2::Y];
+
 /// Tessellates `geometry` under `to_world`, then shifts it so that
 /// `render_origin` becomes the origin, appending to `out`. With `flip`, the
 /// front side of every triangle (its winding and shading normals) is turned
@@ -94,12 +102,18 @@ pub(crate) fn tessellate(
     let point = |p: DVec3| (to_world.transform_point3(p) - render_origin).as_vec3();
     let normal_matrix = DMat3::from_mat4(to_world).inverse().transpose();
     let normal = |n: DVec3| (normal_matrix * n).normalize_or_zero().as_vec3();
+    let tangent = |t: Vec3| {
+        to_world
+            .transform_vector3(t.as_dvec3())
+            .normalize_or_zero()
+            .as_vec3()
+    };
     // A mirroring transform reverses the winding; swap two vertices so the
     // face normal stays the transformed normal. Flipping swaps them (back).
     let swap = (to_world.determinant() < 0.0) != flip;
     let sign = if flip { -1.0 } else { 1.0 };
     let mut dropped = MeshRepairs::default();
-    let mut push = |v: [Vec3; 3], n: [Vec3; 3], uv: [Vec2; 3]| {
+    let mut push = |v: [Vec3; 3], n: [Vec3; 3], uv: [Vec2; 3], t: [Vec3; 3]| {
         let normal = (v[1] - v[0]).cross(v[2] - v[0]);
         if !(keep_all || v.iter().all(|p| p.is_finite()) && normal.is_finite()) {
             dropped.non_finite += 1;
@@ -115,20 +129,21 @@ pub(crate) fn tessellate(
                 v: [v[0], v[2], v[1]],
                 n: [n[0], n[2], n[1]],
                 uv: [uv[0], uv[2], uv[1]],
+                t: [t[0], t[2], t[1]],
             }
         } else {
-            ShapePrim::Triangle { v, n, uv }
+            ShapePrim::Triangle { v, n, uv, t }
         });
     };
     // A quad (a, b, c, d) as the triangles (a, b, c) and (a, c, d), the
     // pair area lights recognise as a rectangle.
-    let quad =
-        |push: &mut dyn FnMut([Vec3; 3], [Vec3; 3], [Vec2; 3]), c: [DVec3; 4], uv: [Vec2; 4]| {
-            let p = c.map(point);
-            let flat = [Vec3::ZERO; 3];
-            push([p[0], p[1], p[2]], flat, [uv[0], uv[1], uv[2]]);
-            push([p[0], p[2], p[3]], flat, [uv[0], uv[2], uv[3]]);
-        };
+    type Push<'p> = dyn FnMut([Vec3; 3], [Vec3; 3], [Vec2; 3], [Vec3; 3]) + 'p;
+    let quad = |push: &mut Push<'_>, c: [DVec3; 4], uv: [Vec2; 4]| {
+        let p = c.map(point);
+        let none = [Vec3::ZERO; 3];
+        push([p[0], p[1], p[2]], none, [uv[0], uv[1], uv[2]], none);
+        push([p[0], p[2], p[3]], none, [uv[0], uv[2], uv[3]], none);
+    };
     match geometry {
         Geometry::Rectangle => quad(
             &mut push,
@@ -161,7 +176,7 @@ pub(crate) fn tessellate(
             });
         }
         Geometry::Mesh(mesh) => {
-            for t in &mesh.triangles {
+            for (f, t) in mesh.triangles.iter().enumerate() {
                 let idx = t.map(|i| i as usize);
                 let v = idx.map(|i| point(mesh.positions[i].as_dvec3()));
                 let n = match &mesh.normals {
@@ -172,9 +187,13 @@ pub(crate) fn tessellate(
                 };
                 let uv = match &mesh.uvs {
                     Some(uvs) => idx.map(|i| uvs[i]),
-                    None => [Vec2::ZERO, Vec2::X, Vec2::Y],
+                    None => BARYCENTRIC_UVS,
                 };
-                push(v, n, uv);
+                let t = match &mesh.tangents {
+                    Some(ts) => ts[f].map(tangent),
+                    None => [Vec3::ZERO; 3],
+                };
+                push(v, n, uv, t);
             }
         }
     }

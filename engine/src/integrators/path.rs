@@ -18,7 +18,7 @@
 //! group of paths that share a material or a light.
 
 use super::sort::sort_by_key;
-use super::surface::{Interaction, interaction};
+use super::surface::{Derivatives, Interaction, interaction, interaction_with_derivatives};
 use crate::accel::offset::{offset_origin, sampled_point_error};
 use crate::accel::{Hit, Motion};
 use crate::extract::{NO_EMITTER, RenderScene};
@@ -80,6 +80,9 @@ pub struct Wavefront {
     prev_pdf: Vec<f32>,
     hit: Vec<Hit>,
     its: Vec<Interaction>,
+    /// Surface derivatives of the hits (only where a shader needs
+    /// [`Effects::TANGENT_FRAMES`]).
+    derivs: Vec<Derivatives>,
     // Live slots, and sort scratch.
     live: Vec<u32>,
     next_live: Vec<u32>,
@@ -90,6 +93,10 @@ pub struct Wavefront {
     ids_k: Vec<SampleId>,
     wo: Vec<Vec3>,
     uv: Vec<Vec2>,
+    /// ∂p/∂u and ∂p/∂v in the local frames (only under
+    /// [`Effects::TANGENT_FRAMES`]).
+    dp_du: Vec<Vec3>,
+    dp_dv: Vec<Vec3>,
     u1: Vec<f32>,
     u2: Vec<Vec2>,
     u3: Vec<Vec3>,
@@ -290,6 +297,9 @@ impl Wavefront {
                 uv: Vec2::ZERO,
             },
         );
+        if scene.effects.contains(Effects::TANGENT_FRAMES) {
+            fit(&mut self.derivs, n);
+        }
         self.live.clear();
         self.live.extend(0..n as u32);
     }
@@ -347,6 +357,8 @@ impl Wavefront {
         // Slices taken once (bounds in registers); slots written by count.
         let (live, hits) = (&self.live[..], &self.hit[..]);
         let (origin, dir, its) = (&self.origin[..], &self.dir[..], &mut self.its[..]);
+        let derivs = &mut self.derivs[..];
+        let tangents = scene.effects.contains(Effects::TANGENT_FRAMES);
         let (next, emitting) = (&mut self.next_live[..], &mut self.em_slots[..]);
         let escaped = &mut self.esc_slots[..];
         let emitter = &scene.surfaces.emitter[..];
@@ -364,7 +376,12 @@ impl Wavefront {
                 continue;
             }
             let tau = if blur { time[i] } else { 0.0 };
-            its[i] = interaction(scene, &hit, origin[i], dir[i], tau);
+            if tangents {
+                (its[i], derivs[i]) =
+                    interaction_with_derivatives(scene, &hit, origin[i], dir[i], tau);
+            } else {
+                its[i] = interaction(scene, &hit, origin[i], dir[i], tau);
+            }
             if has_area && emitter[hit.prim as usize] != NO_EMITTER {
                 emitting[em] = slot;
                 em += 1;
@@ -467,6 +484,18 @@ impl Wavefront {
             *id = ids[i];
             *wo = its[i].frame.to_local(-dir[i]);
             *uv = its[i].uv;
+        }
+        if scene.effects.contains(Effects::TANGENT_FRAMES) {
+            fit(&mut self.dp_du, n);
+            fit(&mut self.dp_dv, n);
+            let derivs = &self.derivs[..];
+            let outputs = self.dp_du.iter_mut().zip(&mut self.dp_dv);
+            for ((du, dv), &slot) in outputs.zip(&self.live) {
+                let i = slot as usize;
+                let frame = &its[i].frame;
+                *du = frame.to_local(derivs[i].dp_du);
+                *dv = frame.to_local(derivs[i].dp_dv);
+            }
         }
         n
     }
@@ -571,9 +600,15 @@ impl Wavefront {
             if a == b {
                 continue;
             }
-            let surface = SurfaceBatch {
-                wo: &self.wo[a..b],
-                uv: &self.uv[a..b],
+            let surface = if shader.effects().contains(Effects::TANGENT_FRAMES) {
+                SurfaceBatch {
+                    wo: &self.wo[a..b],
+                    uv: &self.uv[a..b],
+                    dp_du: &self.dp_du[a..b],
+                    dp_dv: &self.dp_dv[a..b],
+                }
+            } else {
+                SurfaceBatch::new(&self.wo[a..b], &self.uv[a..b])
             };
             shader.sample(&mut ctx, surface, &self.u3[a..b], &mut self.bsdf[a..b]);
             if has_lights && shader.effects().contains(Effects::SMOOTH_LOBES) {

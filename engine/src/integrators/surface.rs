@@ -1,10 +1,30 @@
 //! Surface interactions: what the shading stages need to know about a hit.
+//!
+//! A hit's shading frame has the shading normal as its `n`. Its tangent
+//! `s` matters only to anisotropic lobes, normal maps and bump maps, so
+//! it is oriented only where the frame's effects contain
+//! [`Effects::TANGENT_FRAMES`](radiant_core::Effects)
+//! ([`interaction_with_derivatives`]), as Mitsuba 3 orients it:
+//!
+//! * meshes with texture coordinates: the MikkTSpace vertex tangent,
+//!   interpolated (∂p/∂u of the face where MikkTSpace found none);
+//! * rectangles and cubes: ∂p/∂u of their (Mitsuba 3) parametrization;
+//! * spheres: ∂p/∂u of u = φ/2π, along the object's latitude lines;
+//!
+//! each made orthogonal to the shading normal (Gram–Schmidt), with
+//! `t = n × s`. Where there is no usable parametrization (a mesh without
+//! texture coordinates, degenerate ones, a sphere's pole) the tangent
+//! turns about the primitive's z axis ([`Frame::around_z`]), continuous
+//! wherever the normal is not along z. ∂p/∂u and ∂p/∂v are returned with
+//! their real lengths (the unit vectors of that frame where there are
+//! none). Elsewhere the tangent is whatever [`Frame::from_normal`] makes.
 
 use crate::accel::offset::{sphere_error, triangle_point};
 use crate::accel::{Hit, Placement, Primitive};
-use crate::extract::RenderScene;
+use crate::extract::{BARYCENTRIC_UVS, RenderScene};
 use glam::{Vec2, Vec3};
 use radiant_core::Frame;
+use std::f32::consts::{FRAC_1_PI, PI, TAU};
 
 /// A ray's hit, resolved into geometry and shading data.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -19,6 +39,16 @@ pub struct Interaction {
     pub frame: Frame,
     /// Texture coordinates.
     pub uv: Vec2,
+}
+
+/// The surface's derivatives at a hit, in render space with their real
+/// lengths (scene units per unit of u or v).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Derivatives {
+    /// ∂p/∂u.
+    pub dp_du: Vec3,
+    /// ∂p/∂v.
+    pub dp_dv: Vec3,
 }
 
 /// Least cosine between a shading normal and the geometric normal.
@@ -40,7 +70,8 @@ fn above_tangent_plane(ns: Vec3, ng: Vec3) -> Vec3 {
     }
 }
 
-/// Resolves `hit` of the ray `origin + t·dir` at shutter time `tau`.
+/// Resolves `hit` of the ray `origin + t·dir` at shutter time `tau`, with
+/// a shading frame whose tangent is arbitrary.
 #[inline]
 pub fn interaction(
     scene: &RenderScene,
@@ -49,70 +80,111 @@ pub fn interaction(
     dir: Vec3,
     tau: f32,
 ) -> Interaction {
+    resolve::<false>(scene, hit, origin, dir, tau).0
+}
+
+/// Resolves `hit` as [`interaction`] does, with the shading frame's
+/// tangent oriented by the surface's parametrization, and the surface's
+/// derivatives.
+#[inline]
+pub fn interaction_with_derivatives(
+    scene: &RenderScene,
+    hit: &Hit,
+    origin: Vec3,
+    dir: Vec3,
+    tau: f32,
+) -> (Interaction, Derivatives) {
+    resolve::<true>(scene, hit, origin, dir, tau)
+}
+
+/// The interaction and, with `TANGENTS`, an oriented frame and the
+/// derivatives (zero without).
+#[inline(always)]
+fn resolve<const TANGENTS: bool>(
+    scene: &RenderScene,
+    hit: &Hit,
+    origin: Vec3,
+    dir: Vec3,
+    tau: f32,
+) -> (Interaction, Derivatives) {
     let (prim, placement) = scene.accel.primitive(hit, tau);
-    match placement {
-        None => local_interaction(scene, prim, hit, origin, dir, None),
-        Some(place) => {
-            // In the instance's space (the ray as the query saw it), then
-            // out to render space with the transform's rounding error.
-            let (o, d, _) = place.ray_to_object(origin, dir);
-            let it = local_interaction(scene, prim, hit, o, d, Some(&place));
-            let (p, err) = place.point_to_render(it.p, it.err);
-            let ng = place.normal_to_render(it.ng);
-            let ns = place.normal_to_render(it.frame.n);
-            let ns = if ns == Vec3::ZERO { ng } else { ns };
-            Interaction {
-                p,
-                err,
-                ng,
-                frame: Frame::from_normal(above_tangent_plane(ns, ng)),
-                uv: it.uv,
-            }
-        }
-    }
+    let Some(place) = placement else {
+        return local_interaction::<TANGENTS>(scene, prim, hit, origin, dir, None);
+    };
+    // In the instance's space (the ray as the query saw it), then out to
+    // render space with the transform's rounding error.
+    let (o, d, _) = place.ray_to_object(origin, dir);
+    let (it, dp) = local_interaction::<TANGENTS>(scene, prim, hit, o, d, Some(&place));
+    let (p, err) = place.point_to_render(it.p, it.err);
+    let ng = place.normal_to_render(it.ng);
+    let ns = place.normal_to_render(it.frame.n);
+    let ns = above_tangent_plane(if ns == Vec3::ZERO { ng } else { ns }, ng);
+    let (frame, dp) = if TANGENTS {
+        let to_render = |v: Vec3| place.vector_to_render(v);
+        let dp = Derivatives {
+            dp_du: to_render(dp.dp_du),
+            dp_dv: to_render(dp.dp_dv),
+        };
+        let frame = Frame::with_tangent(ns, to_render(it.frame.s))
+            .unwrap_or_else(|| Frame::around_z(ns));
+        (frame, dp)
+    } else {
+        (Frame::from_normal(ns), dp)
+    };
+    let it = Interaction {
+        p,
+        err,
+        ng,
+        frame,
+        uv: it.uv,
+    };
+    (it, dp)
 }
 
 /// The interaction with `prim` in its own space. Face frames are stored
 /// for primitives in render space only; a placed primitive's frame is
 /// made from its normal (its tangents are turned by the placement anyway).
 #[inline(always)]
-fn local_interaction(
+fn local_interaction<const TANGENTS: bool>(
     scene: &RenderScene,
     prim: Primitive,
     hit: &Hit,
     origin: Vec3,
     dir: Vec3,
     placed: Option<&Placement>,
-) -> Interaction {
+) -> (Interaction, Derivatives) {
     let i = hit.prim as usize;
     match prim {
         Primitive::Triangle(v) => {
-            let b0 = 1.0 - hit.b1 - hit.b2;
-            let (p, err) = triangle_point(&v, b0, hit.b1, hit.b2);
+            let b = [1.0 - hit.b1 - hit.b2, hit.b1, hit.b2];
+            let (p, err) = triangle_point(&v, b[0], b[1], b[2]);
             let face = match placed {
                 None => scene.surfaces.face_frames[i],
                 Some(_) => Frame::from_normal((v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero()),
             };
             let ng = face.n;
             let n = scene.surfaces.normals[i];
-            let frame = if n[0] == Vec3::ZERO {
-                face
+            let ns = (n[0] != Vec3::ZERO).then(|| {
+                let ns = (n[0] * b[0] + n[1] * b[1] + n[2] * b[2]).try_normalize();
+                above_tangent_plane(ns.unwrap_or(ng), ng)
+            });
+            let uvs = scene.surfaces.uvs[i];
+            let uv = uvs[0] * b[0] + uvs[1] * b[1] + uvs[2] * b[2];
+            let (frame, dp) = if TANGENTS {
+                let ns = ns.unwrap_or(ng);
+                let tangent = scene.surfaces.tangents.get(i).map(|t| t[0] * b[0] + t[1] * b[1] + t[2] * b[2]);
+                triangle_frame(ns, &v, &uvs, tangent)
             } else {
-                Frame::from_normal(above_tangent_plane(
-                    (n[0] * b0 + n[1] * hit.b1 + n[2] * hit.b2)
-                        .try_normalize()
-                        .unwrap_or(ng),
-                    ng,
-                ))
+                (ns.map_or(face, Frame::from_normal), Derivatives::default())
             };
-            let uv = scene.surfaces.uvs[i];
-            Interaction {
+            let it = Interaction {
                 p,
                 err,
                 ng,
                 frame,
-                uv: uv[0] * b0 + uv[1] * hit.b1 + uv[2] * hit.b2,
-            }
+                uv,
+            };
+            (it, dp)
         }
         Primitive::Sphere(centre, radius) => {
             let raw = origin + dir * hit.t;
@@ -120,21 +192,97 @@ fn local_interaction(
             // Re-project onto the surface to shrink the error.
             let p = centre + n * radius;
             // Texture coordinates in the sphere's object space (Mitsuba 3's).
-            let [r0, r1, r2] = scene.surfaces.normals[i];
-            let local = Vec3::new(r0.dot(n), r1.dot(n), r2.dot(n));
+            let rows = scene.surfaces.normals[i];
+            let local = Vec3::new(rows[0].dot(n), rows[1].dot(n), rows[2].dot(n));
             let uv = Vec2::new(
-                (local.y.atan2(local.x) * std::f32::consts::FRAC_1_PI * 0.5).rem_euclid(1.0),
-                local.z.clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI,
+                (local.y.atan2(local.x) * FRAC_1_PI * 0.5).rem_euclid(1.0),
+                local.z.clamp(-1.0, 1.0).acos() * FRAC_1_PI,
             );
-            Interaction {
+            let (frame, dp) = if TANGENTS {
+                sphere_frame(n, local, &rows, radius)
+            } else {
+                (Frame::from_normal(n), Derivatives::default())
+            };
+            let it = Interaction {
                 p,
                 err: sphere_error(p) + sphere_error(centre),
                 ng: n,
-                frame: Frame::from_normal(n),
+                frame,
                 uv,
-            }
+            };
+            (it, dp)
         }
     }
+}
+
+/// The shading frame around `ns` of a point of triangle `v` with vertex
+/// texture coordinates `uvs` and interpolated vertex tangent `tangent`
+/// (if the mesh has tangents), and the triangle's derivatives.
+#[inline]
+fn triangle_frame(
+    ns: Vec3,
+    v: &[Vec3; 3],
+    uvs: &[Vec2; 3],
+    tangent: Option<Vec3>,
+) -> (Frame, Derivatives) {
+    let dp = if *uvs == BARYCENTRIC_UVS {
+        None
+    } else {
+        triangle_derivatives(v, uvs)
+    };
+    let frame = tangent
+        .and_then(|t| Frame::with_tangent(ns, t))
+        .or_else(|| dp.and_then(|d| Frame::with_tangent(ns, d.dp_du)))
+        .unwrap_or_else(|| Frame::around_z(ns));
+    let dp = dp.unwrap_or(Derivatives {
+        dp_du: frame.s,
+        dp_dv: frame.t,
+    });
+    (frame, dp)
+}
+
+/// ∂p/∂u and ∂p/∂v of triangle `v` under its texture coordinates `uvs`
+/// (Mitsuba 3's formula); `None` where the coordinates are degenerate.
+#[inline]
+fn triangle_derivatives(v: &[Vec3; 3], uvs: &[Vec2; 3]) -> Option<Derivatives> {
+    let (dp0, dp1) = (v[1] - v[0], v[2] - v[0]);
+    let (duv0, duv1) = (uvs[1] - uvs[0], uvs[2] - uvs[0]);
+    let det = duv0.perp_dot(duv1);
+    let usable = det.abs() > 1e-9 * duv0.length() * duv1.length();
+    if !usable {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let dp = Derivatives {
+        dp_du: (dp0 * duv1.y - dp1 * duv0.y) * inv,
+        dp_dv: (dp1 * duv0.x - dp0 * duv1.x) * inv,
+    };
+    (dp.dp_du.is_finite() && dp.dp_dv.is_finite()).then_some(dp)
+}
+
+/// The shading frame and derivatives at unit normal `n` of a sphere of
+/// radius `radius`, where `local` is `n` in the sphere's object space and
+/// `rows` the rows of the rotation into it (Mitsuba 3's: u = φ/2π,
+/// v = θ/π).
+#[inline]
+fn sphere_frame(n: Vec3, local: Vec3, rows: &[Vec3; 3], radius: f32) -> (Frame, Derivatives) {
+    let out = |v: Vec3| rows[0] * v.x + rows[1] * v.y + rows[2] * v.z;
+    let rd = local.x.hypot(local.y);
+    let dp_dv = if rd > 0.0 {
+        Vec3::new(local.z * local.x / rd, local.z * local.y / rd, -rd)
+    } else {
+        // At the poles, as Mitsuba 3.
+        Vec3::X
+    };
+    let dp = Derivatives {
+        dp_du: out(Vec3::new(-local.y, local.x, 0.0)) * (TAU * radius),
+        dp_dv: out(dp_dv) * (PI * radius),
+    };
+    // At a pole ∂p/∂u vanishes: the frame there is the limit along φ = 0.
+    let frame = Frame::with_tangent(n, dp.dp_du)
+        .or_else(|| Frame::with_tangent(n, n.cross(dp.dp_dv)))
+        .unwrap_or_else(|| Frame::around_z(n));
+    (frame, dp)
 }
 
 #[cfg(test)]

@@ -26,6 +26,7 @@
 mod instances;
 mod keyframes;
 pub mod obj;
+pub mod tangents;
 pub mod transform;
 mod yaml;
 

@@ -20,6 +20,7 @@ use std::path::Path;
 pub fn load_obj(path: &Path, flip_tex_coords: bool) -> Result<MeshData, String> {
     let mut mesh = read_obj(path, flip_tex_coords)?;
     repair(&mut mesh);
+    mesh.tangents = super::tangents::mikktspace(&mesh);
     if mesh.triangles.is_empty() {
         return Err(format!(
             "mesh file `{}` has no usable triangles ({} dropped as degenerate, {} for non-finite coordinates)",
@@ -38,6 +39,7 @@ pub fn load_obj(path: &Path, flip_tex_coords: bool) -> Result<MeshData, String> 
 pub fn load_obj_frame(path: &Path, flip_tex_coords: bool) -> Result<MeshData, String> {
     let mut mesh = read_obj(path, flip_tex_coords)?;
     repair_attributes(&mut mesh);
+    mesh.tangents = super::tangents::mikktspace(&mesh);
     if mesh.triangles.is_empty() {
         return Err(format!("mesh file `{}` has no triangles", path.display()));
     }

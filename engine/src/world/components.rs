@@ -292,6 +292,9 @@ pub struct MeshData {
     pub normals: Option<Vec<Vec3>>,
     /// Per-vertex texture coordinates, if the mesh has them.
     pub uvs: Option<Vec<Vec2>>,
+    /// Per triangle, the MikkTSpace tangent (unit, along ∂p/∂u) at each of
+    /// its vertices, where the mesh has texture coordinates.
+    pub tangents: Option<Vec<[Vec3; 3]>>,
     /// Vertex indices of each triangle.
     pub triangles: Vec<[u32; 3]>,
     /// What loading repaired.

@@ -31,6 +31,11 @@ bitflags! {
         /// Geometry or the camera moving while the shutter is open: rays
         /// carry a time (set by the engine, not by modules).
         const MOTION_BLUR = 1 << 9;
+        /// A shader whose response depends on the direction of the shading
+        /// frame's tangent or on ∂p/∂u and ∂p/∂v (anisotropic lobes, normal
+        /// and bump maps): hits orient their frames by the texture
+        /// parametrisation and shaders receive the derivatives.
+        const TANGENT_FRAMES = 1 << 10;
     }
 }
 

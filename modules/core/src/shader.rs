@@ -5,19 +5,62 @@
 //! where it comes from. Values include the cosine foreshortening factor
 //! |cos θi|, so a path's throughput is multiplied by `weight` directly.
 
-use crate::{Effects, Rgb, TextureId, TextureTable};
+use crate::{Effects, Frame, Rgb, TextureId, TextureTable};
 use glam::{Vec2, Vec3};
 
 /// The surface points of one shading batch.
+///
+/// The local shading frame's tangent (+x) points along ∂p/∂u made
+/// orthogonal to the shading normal — or, on meshes, along the vertex
+/// tangents MikkTSpace makes from the texture coordinates — wherever the
+/// frame's effects contain [`Effects::TANGENT_FRAMES`](crate::Effects);
+/// elsewhere its direction about the normal is arbitrary.
 #[derive(Clone, Copy)]
 pub struct SurfaceBatch<'a> {
     /// Outgoing directions, local frame, unit length.
     pub wo: &'a [Vec3],
     /// Surface texture coordinates.
     pub uv: &'a [Vec2],
+    /// ∂p/∂u in the local shading frame, with its length (scene units per
+    /// unit of u); empty unless the frame's effects contain
+    /// [`Effects::TANGENT_FRAMES`](crate::Effects).
+    pub dp_du: &'a [Vec3],
+    /// ∂p/∂v likewise.
+    pub dp_dv: &'a [Vec3],
 }
 
-impl SurfaceBatch<'_> {
+impl<'a> SurfaceBatch<'a> {
+    /// A batch of points without surface derivatives (for shaders that do
+    /// not declare [`Effects::TANGENT_FRAMES`](crate::Effects)).
+    pub fn new(wo: &'a [Vec3], uv: &'a [Vec2]) -> Self {
+        Self {
+            wo,
+            uv,
+            dp_du: &[],
+            dp_dv: &[],
+        }
+    }
+
+    /// The same points seen from directions `wo` (a wrapper's perturbed
+    /// frame): texture coordinates and derivatives are passed on.
+    pub fn with_wo<'b>(&self, wo: &'b [Vec3]) -> SurfaceBatch<'b>
+    where
+        'a: 'b,
+    {
+        SurfaceBatch { wo, ..*self }
+    }
+
+    /// The points `range` of the batch.
+    pub fn slice(&self, range: std::ops::Range<usize>) -> SurfaceBatch<'a> {
+        let part = |v: &'a [Vec3]| if v.is_empty() { v } else { &v[range.clone()] };
+        SurfaceBatch {
+            wo: &self.wo[range.clone()],
+            uv: &self.uv[range.clone()],
+            dp_du: part(self.dp_du),
+            dp_dv: part(self.dp_dv),
+        }
+    }
+
     /// Number of surface points in the batch.
     pub fn len(&self) -> usize {
         self.wo.len()
@@ -92,6 +135,7 @@ pub struct Scratch {
     index: Vec<Vec<u32>>,
     samples: Vec<Vec<BsdfSample>>,
     evals: Vec<Vec<BsdfEval>>,
+    frames: Vec<Vec<Frame>>,
 }
 
 /// Element types that [`ShadeContext::take`] can lend buffers of.
@@ -110,7 +154,7 @@ macro_rules! pooled {
     )*};
 }
 
-pooled!(Vec3 => vec3, Vec2 => vec2, f32 => float, u32 => index, BsdfSample => samples, BsdfEval => evals);
+pooled!(Vec3 => vec3, Vec2 => vec2, f32 => float, u32 => index, BsdfSample => samples, BsdfEval => evals, Frame => frames);
 
 impl<'a> ShadeContext<'a> {
     /// Creates a context over the scene's textures.

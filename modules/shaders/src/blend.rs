@@ -72,13 +72,26 @@ impl Blend {
         let mut uv = ctx.take::<Vec2>(idx.len());
         let mut uu = ctx.take::<Vec3>(idx.len());
         let mut res = ctx.take::<BsdfSample>(idx.len());
+        let derivatives = !surface.dp_du.is_empty();
+        let m = if derivatives { idx.len() } else { 0 };
+        let (mut du, mut dv) = (ctx.take::<Vec3>(m), ctx.take::<Vec3>(m));
         for (k, &i) in idx.iter().enumerate() {
             let i = i as usize;
             wo[k] = surface.wo[i];
             uv[k] = surface.uv[i];
             uu[k] = u[i];
+            if derivatives {
+                du[k] = surface.dp_du[i];
+                dv[k] = surface.dp_dv[i];
+            }
         }
-        self.parts[part].sample(ctx, SurfaceBatch { wo: &wo, uv: &uv }, &uu, &mut res);
+        let part_surface = SurfaceBatch {
+            wo: &wo,
+            uv: &uv,
+            dp_du: &du,
+            dp_dv: &dv,
+        };
+        self.parts[part].sample(ctx, part_surface, &uu, &mut res);
         for (k, &i) in idx.iter().enumerate() {
             let mut s = res[k];
             s.pdf *= prob[i as usize];
@@ -88,6 +101,8 @@ impl Blend {
         ctx.recycle(uv);
         ctx.recycle(uu);
         ctx.recycle(res);
+        ctx.recycle(du);
+        ctx.recycle(dv);
     }
 }
 

@@ -1,11 +1,15 @@
 //! The `bump` shader: wraps a material and tilts its shading normal by the
-//! gradient of a height texture, n′ ∝ (−scale·∂h/∂u, −scale·∂h/∂v, 1),
-//! with the gradient taken by central differences of step [`STEP`] in
-//! (u, v). See [`crate::perturb`] for the frame and its limits (u and v
-//! are taken along the shading frame's tangents at unit scale).
+//! gradient of a height texture, as Mitsuba 3's `bumpmap`: the surface's
+//! ∂p/∂u and ∂p/∂v get normal components scale·∂h/∂u and scale·∂h/∂v in
+//! place of their own, and the perturbed normal is their cross product
+//! (turned to the side of the shading normal), so the relief depends on
+//! the parametrisation's real scale, not on the frame. The gradient is
+//! taken by central differences of step [`STEP`] in (u, v). See
+//! [`crate::perturb`] for the frame.
 
 use crate::inputs::scalar;
-use crate::perturb::{self, NormalSource, Perturbed};
+use crate::perturb::{self, FrameSource, Perturbed};
+use radiant_core::Frame;
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::{
@@ -60,8 +64,8 @@ struct BumpNormals {
     scale: f32,
 }
 
-impl NormalSource for BumpNormals {
-    fn normals(&self, ctx: &mut ShadeContext<'_>, surface: SurfaceBatch<'_>) -> Vec<Vec3> {
+impl FrameSource for BumpNormals {
+    fn frames(&self, ctx: &mut ShadeContext<'_>, surface: SurfaceBatch<'_>) -> Vec<Frame> {
         let uv = surface.uv;
         let n = uv.len();
         let mut shifted = ctx.take::<Vec2>(4 * n);
@@ -71,16 +75,23 @@ impl NormalSource for BumpNormals {
             shifted[2 * n + i] = *uv + Vec2::new(0.0, STEP);
             shifted[3 * n + i] = *uv - Vec2::new(0.0, STEP);
         }
-        let mut normals = ctx.take::<Vec3>(n);
+        let mut frames = ctx.take::<Frame>(n);
         let [h] = ctx.lookup([self.height], &shifted);
         let k = self.scale / (2.0 * STEP);
-        for (i, normal) in normals.iter_mut().enumerate() {
-            let du = (scalar(h[i]) - scalar(h[n + i])) * k;
-            let dv = (scalar(h[2 * n + i]) - scalar(h[3 * n + i])) * k;
-            *normal = perturb::sanitise(Vec3::new(-du, -dv, 1.0));
+        for (i, frame) in frames.iter_mut().enumerate() {
+            let hu = (scalar(h[i]) - scalar(h[n + i])) * k;
+            let hv = (scalar(h[2 * n + i]) - scalar(h[3 * n + i])) * k;
+            // The derivatives with their normal (z) components replaced
+            // by the height's gradient.
+            let (du, dv) = perturb::derivatives(&surface, i);
+            let du = Vec3::new(du.x, du.y, hu);
+            let dv = Vec3::new(dv.x, dv.y, hv);
+            let normal = du.cross(dv).try_normalize().unwrap_or(Vec3::Z);
+            let normal = if normal.z < 0.0 { -normal } else { normal };
+            *frame = perturb::frame_along(perturb::sanitise(normal), du);
         }
         ctx.recycle(shifted);
-        normals
+        frames
     }
 }
 

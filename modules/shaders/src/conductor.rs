@@ -5,7 +5,9 @@
 //! colour. Mitsuba 3's `conductor` and `roughconductor` in one module.
 
 use crate::fresnel;
-use crate::inputs::{ROUGHNESS_DOCS, Roughness, fraction, one, roughness, scalar, texture_effects};
+use crate::inputs::{
+    ROUGHNESS_DOCS, Roughness, anisotropy, fraction, one, roughness, scalar, texture_effects,
+};
 use crate::lobes::{mirror_sample, reflection_sample};
 use crate::metals;
 use crate::microfacet::{Ggx, reflect};
@@ -218,7 +220,9 @@ fn build(
         fresnel,
         specular,
         rough,
-        effects: lobes | texture_effects(ctx, &[specular, rough.u, rough.v]),
+        effects: lobes
+            | texture_effects(ctx, &[specular, rough.u, rough.v])
+            | anisotropy(ctx, rough.u, rough.v),
     })
 }
 

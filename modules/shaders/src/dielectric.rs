@@ -8,7 +8,7 @@
 use crate::fresnel;
 use crate::inputs::{
     BK7, Ior, ROUGHNESS_DOCS, Roughness, fraction, one, relative_ior, roughness, scalar,
-    texture_effects,
+    texture_effects, anisotropy,
 };
 use crate::lobes::{interface_eval, interface_sample, mirror_sample};
 use crate::microfacet::Ggx;
@@ -190,7 +190,8 @@ fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Dielectric, Para
         rough,
         effects: lobes
             | Effects::TRANSMISSION
-            | texture_effects(ctx, &[reflectance, transmittance, rough.u, rough.v]),
+            | texture_effects(ctx, &[reflectance, transmittance, rough.u, rough.v])
+            | anisotropy(ctx, rough.u, rough.v),
     })
 }
 

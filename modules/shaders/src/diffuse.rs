@@ -136,7 +136,7 @@ mod tests {
                 )
             })
             .collect();
-        let surface = SurfaceBatch { wo: &wo, uv: &uv };
+        let surface = SurfaceBatch::new(&wo, &uv);
         let mut samples = vec![BsdfSample::default(); n * n];
         shader.sample(&mut ctx, surface, &u, &mut samples);
         let wi: Vec<Vec3> = samples.iter().map(|s| s.wi).collect();
@@ -160,10 +160,8 @@ mod tests {
         let white = textures.add_constant(Rgb::ONE);
         let shader = Diffuse::new(white, Effects::empty());
         let mut ctx = ShadeContext::new(&textures);
-        let surface = SurfaceBatch {
-            wo: &[Vec3::new(0.0, 0.0, -1.0)],
-            uv: &[Vec2::ZERO],
-        };
+        let (wo, uv) = ([Vec3::new(0.0, 0.0, -1.0)], [Vec2::ZERO]);
+        let surface = SurfaceBatch::new(&wo, &uv);
         let mut e = [BsdfEval::default()];
         shader.eval(&mut ctx, surface, &[Vec3::Z], &mut e);
         assert_eq!(e[0].value, Rgb::ZERO);

@@ -4,7 +4,7 @@
 //! (diffuse and specular reflectance, two anisotropic roughness values).
 //! The models differ only in their [`HalfVectorLobes`].
 
-use crate::inputs::texture_effects;
+use crate::inputs::{anisotropy, texture_effects};
 use crate::lobes::reflection_sample;
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::warp::square_to_cosine_hemisphere;
@@ -52,7 +52,10 @@ impl<L> HalfVectorShader<L> {
     pub(crate) fn new(ctx: &BuildContext<'_>, textures: [TextureId; 4]) -> Self {
         Self {
             textures,
-            effects: Effects::SMOOTH_LOBES | Effects::GLOSSY | texture_effects(ctx, &textures),
+            effects: Effects::SMOOTH_LOBES
+                | Effects::GLOSSY
+                | texture_effects(ctx, &textures)
+                | anisotropy(ctx, textures[2], textures[3]),
             lobes: PhantomData,
         }
     }

@@ -43,6 +43,21 @@ pub(crate) fn texture_effects(ctx: &BuildContext<'_>, ids: &[TextureId]) -> Effe
         .fold(Effects::empty(), |e, &id| e | ctx.textures.effects(id))
 }
 
+/// [`Effects::TANGENT_FRAMES`] where the parameters along the shading
+/// frame's two tangents, `u` and `v`, may differ (an anisotropic lobe);
+/// empty where they are the same constant.
+pub(crate) fn anisotropy(ctx: &BuildContext<'_>, u: TextureId, v: TextureId) -> Effects {
+    let same = u == v || {
+        let (a, b) = (ctx.textures.constant(u), ctx.textures.constant(v));
+        a.is_some() && a == b
+    };
+    if same {
+        Effects::empty()
+    } else {
+        Effects::TANGENT_FRAMES
+    }
+}
+
 /// A scalar from a colour value: the mean of its channels.
 #[inline]
 pub(crate) fn scalar(c: Rgb) -> f32 {

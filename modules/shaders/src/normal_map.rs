@@ -1,9 +1,11 @@
 //! The `normal_map` shader: wraps a material and replaces its shading
 //! normal by one read from a texture (RGB in [0, 1] encoding a
-//! tangent-space normal as 2·c − 1, +z out of the surface). See
-//! [`crate::perturb`] for the frame and its limits.
+//! tangent-space normal as 2·c − 1: +x along ∂p/∂u, +z out of the
+//! surface — uv tangent space, as Mitsuba 3's `normalmap` and normal-map
+//! bakers define it). See [`crate::perturb`] for the frame.
 
-use crate::perturb::{self, NormalSource, Perturbed};
+use crate::perturb::{self, FrameSource, Perturbed};
+use radiant_core::Frame;
 use radiant_core::glam::Vec3;
 use radiant_core::params::Spanned;
 use radiant_core::{
@@ -42,14 +44,18 @@ struct MapNormals {
     normals: TextureId,
 }
 
-impl NormalSource for MapNormals {
-    fn normals(&self, ctx: &mut ShadeContext<'_>, surface: SurfaceBatch<'_>) -> Vec<Vec3> {
-        let mut normals = ctx.take::<Vec3>(surface.len());
+impl FrameSource for MapNormals {
+    /// Mitsuba 3's `normalmap`: n′ = normalize(2·c − 1) in the shading
+    /// frame, first tangent ∂p/∂u made orthogonal to n′.
+    fn frames(&self, ctx: &mut ShadeContext<'_>, surface: SurfaceBatch<'_>) -> Vec<Frame> {
+        let n = surface.len();
+        let mut frames = ctx.take::<Frame>(n);
         let [c] = ctx.lookup([self.normals], surface.uv);
-        for (n, c) in normals.iter_mut().zip(c) {
-            *n = perturb::sanitise(2.0 * *c - Vec3::ONE);
+        for (i, (f, c)) in frames.iter_mut().zip(c).enumerate() {
+            let normal = perturb::sanitise(2.0 * *c - Vec3::ONE);
+            *f = perturb::frame_along(normal, perturb::derivatives(&surface, i).0);
         }
-        normals
+        frames
     }
 }
 
