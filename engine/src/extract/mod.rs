@@ -30,8 +30,8 @@ mod sequence;
 mod shapes;
 
 pub use lights::LightTable;
-pub(crate) use shapes::BARYCENTRIC_UVS;
 pub use sequence::{FrameUpdate, Sequence, SequenceOptions};
+pub(crate) use shapes::BARYCENTRIC_UVS;
 
 use crate::accel::{Accel, Hit, Motion};
 use crate::error::SceneError;

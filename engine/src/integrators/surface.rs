@@ -125,8 +125,8 @@ fn resolve<const TANGENTS: bool>(
             dp_du: to_render(dp.dp_du),
             dp_dv: to_render(dp.dp_dv),
         };
-        let frame = Frame::with_tangent(ns, to_render(it.frame.s))
-            .unwrap_or_else(|| Frame::around_z(ns));
+        let frame =
+            Frame::with_tangent(ns, to_render(it.frame.s)).unwrap_or_else(|| Frame::around_z(ns));
         (frame, dp)
     } else {
         (Frame::from_normal(ns), dp)
@@ -172,7 +172,11 @@ fn local_interaction<const TANGENTS: bool>(
             let uv = uvs[0] * b[0] + uvs[1] * b[1] + uvs[2] * b[2];
             let (frame, dp) = if TANGENTS {
                 let ns = ns.unwrap_or(ng);
-                let tangent = scene.surfaces.tangents.get(i).map(|t| t[0] * b[0] + t[1] * b[1] + t[2] * b[2]);
+                let tangent = scene
+                    .surfaces
+                    .tangents
+                    .get(i)
+                    .map(|t| t[0] * b[0] + t[1] * b[1] + t[2] * b[2]);
                 triangle_frame(ns, &v, &uvs, tangent)
             } else {
                 (ns.map_or(face, Frame::from_normal), Derivatives::default())

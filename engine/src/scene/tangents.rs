@@ -53,7 +53,11 @@ impl Geometry for Faces<'_> {
     }
 
     fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
-        let uvs = self.mesh.uvs.as_ref().expect("tangents need texture coordinates");
+        let uvs = self
+            .mesh
+            .uvs
+            .as_ref()
+            .expect("tangents need texture coordinates");
         uvs[self.vertex(face, vert)].to_array()
     }
 
@@ -92,7 +96,10 @@ mod tests {
                 let a = i as f32 / (n - 1) as f32 * std::f32::consts::FRAC_PI_2;
                 mesh.positions.push(Vec3::new(a.cos(), j as f32, a.sin()));
                 normals.push(Vec3::new(a.cos(), 0.0, a.sin()));
-                uvs.push(Vec2::new(i as f32 / (n - 1) as f32, j as f32 / (m - 1) as f32));
+                uvs.push(Vec2::new(
+                    i as f32 / (n - 1) as f32,
+                    j as f32 / (m - 1) as f32,
+                ));
             }
         }
         for j in 0..m - 1 {

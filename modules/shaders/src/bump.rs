@@ -8,8 +8,7 @@
 //! [`crate::perturb`] for the frame.
 
 use crate::inputs::scalar;
-use crate::perturb::{self, FrameSource, Perturbed};
-use radiant_core::Frame;
+use crate::perturb::{self, NormalSource, PerturbOptions, Perturbed};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::{
@@ -25,6 +24,10 @@ struct BumpParams {
     height: Spanned<TextureInput>,
     #[serde(default = "one")]
     scale: f32,
+    #[serde(default = "perturb::yes")]
+    flip_invalid_normals: bool,
+    #[serde(default = "perturb::yes")]
+    use_shadowing_function: bool,
     // Read through `BuildContext::material`; listed for key checking.
     #[serde(rename = "material")]
     _material: IgnoredAny,
@@ -53,6 +56,8 @@ const DOCS: &[ParamDoc] = &[
         default: "required",
         doc: "The material whose shading normal is tilted.",
     },
+    perturb::FLIP_DOC,
+    perturb::SHADOWING_DOC,
 ];
 
 /// Finite-difference step in (u, v).
@@ -64,8 +69,8 @@ struct BumpNormals {
     scale: f32,
 }
 
-impl FrameSource for BumpNormals {
-    fn frames(&self, ctx: &mut ShadeContext<'_>, surface: SurfaceBatch<'_>) -> Vec<Frame> {
+impl NormalSource for BumpNormals {
+    fn normals(&self, ctx: &mut ShadeContext<'_>, surface: SurfaceBatch<'_>) -> Vec<Vec3> {
         let uv = surface.uv;
         let n = uv.len();
         let mut shifted = ctx.take::<Vec2>(4 * n);
@@ -75,10 +80,10 @@ impl FrameSource for BumpNormals {
             shifted[2 * n + i] = *uv + Vec2::new(0.0, STEP);
             shifted[3 * n + i] = *uv - Vec2::new(0.0, STEP);
         }
-        let mut frames = ctx.take::<Frame>(n);
+        let mut normals = ctx.take::<Vec3>(n);
         let [h] = ctx.lookup([self.height], &shifted);
         let k = self.scale / (2.0 * STEP);
-        for (i, frame) in frames.iter_mut().enumerate() {
+        for (i, out) in normals.iter_mut().enumerate() {
             let hu = (scalar(h[i]) - scalar(h[n + i])) * k;
             let hv = (scalar(h[2 * n + i]) - scalar(h[3 * n + i])) * k;
             // The derivatives with their normal (z) components replaced
@@ -88,10 +93,10 @@ impl FrameSource for BumpNormals {
             let dv = Vec3::new(dv.x, dv.y, hv);
             let normal = du.cross(dv).try_normalize().unwrap_or(Vec3::Z);
             let normal = if normal.z < 0.0 { -normal } else { normal };
-            *frame = perturb::frame_along(perturb::sanitise(normal), du);
+            *out = perturb::sanitise(normal);
         }
         ctx.recycle(shifted);
-        frames
+        normals
     }
 }
 
@@ -111,7 +116,11 @@ fn build(
         height,
         scale: p.scale,
     };
-    Perturbed::new(source, height, params, ctx)
+    let options = PerturbOptions {
+        flip_invalid_normals: p.flip_invalid_normals,
+        use_shadowing_function: p.use_shadowing_function,
+    };
+    Perturbed::new(source, height, options, params, ctx)
 }
 
 pub(crate) fn register(registry: &mut Registry) {

@@ -7,8 +7,8 @@
 
 use crate::fresnel;
 use crate::inputs::{
-    BK7, Ior, ROUGHNESS_DOCS, Roughness, fraction, one, relative_ior, roughness, scalar,
-    texture_effects, anisotropy,
+    BK7, Ior, ROUGHNESS_DOCS, Roughness, anisotropy, fraction, one, relative_ior, roughness,
+    scalar, texture_effects,
 };
 use crate::lobes::{interface_eval, interface_sample, mirror_sample};
 use crate::microfacet::Ggx;

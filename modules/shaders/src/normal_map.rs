@@ -4,8 +4,7 @@
 //! surface — uv tangent space, as Mitsuba 3's `normalmap` and normal-map
 //! bakers define it). See [`crate::perturb`] for the frame.
 
-use crate::perturb::{self, FrameSource, Perturbed};
-use radiant_core::Frame;
+use crate::perturb::{self, NormalSource, PerturbOptions, Perturbed};
 use radiant_core::glam::Vec3;
 use radiant_core::params::Spanned;
 use radiant_core::{
@@ -19,6 +18,10 @@ use serde::de::IgnoredAny;
 #[serde(deny_unknown_fields)]
 struct NormalMapParams {
     normals: Spanned<TextureInput>,
+    #[serde(default = "perturb::yes")]
+    flip_invalid_normals: bool,
+    #[serde(default = "perturb::yes")]
+    use_shadowing_function: bool,
     // Read through `BuildContext::material`; listed for key checking.
     #[serde(rename = "material")]
     _material: IgnoredAny,
@@ -37,6 +40,8 @@ const DOCS: &[ParamDoc] = &[
         default: "required",
         doc: "The material whose shading normal is replaced.",
     },
+    perturb::FLIP_DOC,
+    perturb::SHADOWING_DOC,
 ];
 
 /// Normals read from a texture.
@@ -44,25 +49,27 @@ struct MapNormals {
     normals: TextureId,
 }
 
-impl FrameSource for MapNormals {
+impl NormalSource for MapNormals {
     /// Mitsuba 3's `normalmap`: n′ = normalize(2·c − 1) in the shading
-    /// frame, first tangent ∂p/∂u made orthogonal to n′.
-    fn frames(&self, ctx: &mut ShadeContext<'_>, surface: SurfaceBatch<'_>) -> Vec<Frame> {
-        let n = surface.len();
-        let mut frames = ctx.take::<Frame>(n);
+    /// frame.
+    fn normals(&self, ctx: &mut ShadeContext<'_>, surface: SurfaceBatch<'_>) -> Vec<Vec3> {
+        let mut normals = ctx.take::<Vec3>(surface.len());
         let [c] = ctx.lookup([self.normals], surface.uv);
-        for (i, (f, c)) in frames.iter_mut().zip(c).enumerate() {
-            let normal = perturb::sanitise(2.0 * *c - Vec3::ONE);
-            *f = perturb::frame_along(normal, perturb::derivatives(&surface, i).0);
+        for (normal, c) in normals.iter_mut().zip(c) {
+            *normal = perturb::sanitise(2.0 * *c - Vec3::ONE);
         }
-        frames
+        normals
     }
 }
 
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Perturbed<MapNormals>, ParamError> {
     let p: NormalMapParams = params.parse()?;
     let normals = ctx.texture(&p.normals)?;
-    Perturbed::new(MapNormals { normals }, normals, params, ctx)
+    let options = PerturbOptions {
+        flip_invalid_normals: p.flip_invalid_normals,
+        use_shadowing_function: p.use_shadowing_function,
+    };
+    Perturbed::new(MapNormals { normals }, normals, options, params, ctx)
 }
 
 pub(crate) fn register(registry: &mut Registry) {
