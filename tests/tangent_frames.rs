@@ -18,6 +18,7 @@ use radiant::extract::{Overrides, RenderScene, extract};
 use radiant::film::Image;
 use radiant::film::output::read_exr;
 use radiant::integrators::surface::interaction_with_derivatives;
+use radiant_tests::block_channel_means;
 
 /// The local shading frame turned 90° about the normal: what a renderer
 /// whose tangents are off by a quarter turn would hand the material.
@@ -113,23 +114,11 @@ fn extract_text(name: &str, text: &str) -> RenderScene {
 /// highlights in relative ones).
 fn worst_block(a: &Image, b: &Image) -> f64 {
     assert_eq!((a.width, a.height), (b.width, b.height));
-    let w = a.width as usize;
+    let (ma, mb) = (block_channel_means(a, 8), block_channel_means(b, 8));
     let mut worst: f64 = 0.0;
-    for by in 0..a.height as usize / 8 {
-        for bx in 0..w / 8 {
-            for c in 0..3 {
-                let mean = |img: &Image| {
-                    let mut s = 0.0;
-                    for y in 0..8 {
-                        for x in 0..8 {
-                            s += f64::from(img.pixels[(by * 8 + y) * w + bx * 8 + x][c]);
-                        }
-                    }
-                    s / 64.0
-                };
-                let (ma, mb) = (mean(a), mean(b));
-                worst = worst.max((ma - mb).abs() / (mb + FLOOR));
-            }
+    for (x, r) in ma.iter().zip(&mb) {
+        for c in 0..3 {
+            worst = worst.max((x[c] - r[c]).abs() / (r[c] + FLOOR));
         }
     }
     worst
@@ -139,8 +128,9 @@ fn worst_block(a: &Image, b: &Image) -> f64 {
 /// mean brightness.
 const FLOOR: f64 = 0.05;
 
-/// The block error that passes (measured: see the closing note of the
-/// tangent-frame issue; a turned frame is off by far more).
+/// The block error that passes (measured at the committed 128 spp: at
+/// most 0.035, on the anisotropic highlights; any object's frame turned
+/// 90° gives 0.39 or more).
 const TOLERANCE: f64 = 0.1;
 
 /// Asserts that scene `name` matches Mitsuba and that turning any one

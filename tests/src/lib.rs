@@ -70,6 +70,30 @@ pub fn channel_means(image: &Image) -> [f64; 3] {
     m.map(|v| v / image.pixels.len() as f64)
 }
 
+/// Means of each colour channel over the whole `block`×`block` pixel
+/// blocks of `image` (a partial last row or column of blocks is left out),
+/// row-major.
+pub fn block_channel_means(image: &Image, block: usize) -> Vec<[f64; 3]> {
+    let w = image.width as usize;
+    let (bw, bh) = (w / block, image.height as usize / block);
+    let mut means = vec![[0.0f64; 3]; bw * bh];
+    for by in 0..bh {
+        for bx in 0..bw {
+            let m = &mut means[by * bw + bx];
+            for y in by * block..(by + 1) * block {
+                for x in bx * block..(bx + 1) * block {
+                    let p = image.pixels[y * w + x];
+                    for (c, v) in m.iter_mut().enumerate() {
+                        *v += f64::from(p[c]);
+                    }
+                }
+            }
+            *m = m.map(|v| v / (block * block) as f64);
+        }
+    }
+    means
+}
+
 /// The result of comparing a render with a converged reference.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ReferenceCheck {
