@@ -162,13 +162,44 @@ fn lossy_shaders_never_exceed_one() {
     eprintln!("Oren–Nayar furnace peaks at {worst_oren_nayar}");
 }
 
+/// Relative tolerance of a sample's density and weight against `eval`'s
+/// at density `pdf` for the directions `wo`, `wi`: single-precision
+/// rounding, which near-delta lobes amplify in proportion to their density
+/// (half vectors of nearly equal directions cancel) and grazing directions
+/// amplify further. Measured: below 1e-4 for densities under 1e3, 6e-4 at
+/// 1e6 (α = 0.001), 5e-3 at 1.4e7 (refraction at η = 1.0001), 7e-3 with
+/// both directions within 1° of the horizon. Refraction at η = 1.0001
+/// (`index_matched`) cancels in every half vector: up to 5e-3. A 0.2 %
+/// error of an ordinary lobe (density below 1e5, away from the horizon)
+/// fails.
+fn density_tolerance(pdf: f32, wo: Vec3, wi: Vec3, index_matched: bool) -> f32 {
+    if index_matched || wo.z.abs().min(wi.z.abs()) < 0.02 {
+        3e-2
+    } else {
+        1e-3 + 1e-9 * pdf
+    }
+}
+
 #[test]
 fn sample_weights_and_densities_agree_with_eval() {
     for yaml in ALL.iter().chain(LOSSY) {
         let s = shader(yaml);
         let mut rng = Rng::new(7);
-        for &c in &[0.9f32, 0.4, 0.05, -0.6] {
-            let wo = direction(c, 1.1);
+        let (mut worst_pdf, mut worst_weight) = (0.0f32, 0.0f32);
+        // Four fixed incidences and four random ones (both sides).
+        let random: Vec<(f32, f32)> = (0..4)
+            .map(|_| {
+                (
+                    2.0 * rng.uniform() - 1.0,
+                    std::f32::consts::TAU * rng.uniform(),
+                )
+            })
+            .collect();
+        for &(c, phi) in [(0.9f32, 1.1f32), (0.4, 1.1), (0.05, 1.1), (-0.6, 1.1)]
+            .iter()
+            .chain(&random)
+        {
+            let wo = direction(c, phi);
             let u: Vec<Vec3> = (0..2000)
                 .map(|_| Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()))
                 .collect();
@@ -177,11 +208,10 @@ fn sample_weights_and_densities_agree_with_eval() {
                     continue;
                 }
                 let e = s.eval(wo, b.wi);
-                // f32 cancellation near index-matched refraction (η =
-                // 1.0001) costs up to ~0.3 %.
                 let rel = (e.pdf - b.pdf).abs() / b.pdf;
+                worst_pdf = worst_pdf.max(rel);
                 assert!(
-                    rel < 1e-2,
+                    rel < density_tolerance(b.pdf, wo, b.wi, yaml.contains("1.0001")),
                     "{yaml}: pdf {} vs eval {} at wo {wo} wi {}",
                     b.pdf,
                     e.pdf,
@@ -189,14 +219,16 @@ fn sample_weights_and_densities_agree_with_eval() {
                 );
                 let w = e.value / e.pdf;
                 let err = (w - b.weight).abs().max_element() / b.weight.max_element().max(1e-3);
+                worst_weight = worst_weight.max(err);
                 assert!(
-                    err < 1e-2,
+                    err < density_tolerance(b.pdf, wo, b.wi, yaml.contains("1.0001")),
                     "{yaml}: weight {} vs eval/pdf {w} at wo {wo} wi {}",
                     b.weight,
                     b.wi
                 );
             }
         }
+        eprintln!("{yaml}: worst density {worst_pdf:.1e}, weight {worst_weight:.1e}");
     }
 }
 
