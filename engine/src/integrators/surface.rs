@@ -229,7 +229,11 @@ fn triangle_frame(
     uvs: &[Vec2; 3],
     tangent: Option<Vec3>,
 ) -> (Frame, Derivatives) {
-    let dp = if *uvs == BARYCENTRIC_UVS {
+    // A mesh without texture coordinates has the placeholder uvs and no
+    // tangents; a real triangle that happens to have the same uvs has
+    // MikkTSpace tangents.
+    let uvless = *uvs == BARYCENTRIC_UVS && tangent.is_none_or(|t| t == Vec3::ZERO);
+    let dp = if uvless {
         None
     } else {
         triangle_derivatives(v, uvs)
@@ -282,9 +286,10 @@ fn sphere_frame(n: Vec3, local: Vec3, rows: &[Vec3; 3], radius: f32) -> (Frame, 
         dp_du: out(Vec3::new(-local.y, local.x, 0.0)) * (TAU * radius),
         dp_dv: out(dp_dv) * (PI * radius),
     };
-    // At a pole ∂p/∂u vanishes: the frame there is the limit along φ = 0.
+    // At a pole ∂p/∂u vanishes: the frame there is its limit along φ = 0,
+    // the object's +y at both poles.
     let frame = Frame::with_tangent(n, dp.dp_du)
-        .or_else(|| Frame::with_tangent(n, n.cross(dp.dp_dv)))
+        .or_else(|| Frame::with_tangent(n, out(Vec3::Y)))
         .unwrap_or_else(|| Frame::around_z(n));
     (frame, dp)
 }
@@ -308,5 +313,37 @@ mod tests {
         }
         // Reversed: the geometric normal.
         assert!((above_tangent_plane(-Vec3::Z, ng) - ng).length() < 1e-6);
+    }
+
+    /// A triangle of a textured mesh whose uvs happen to equal the
+    /// placeholder of uv-less meshes keeps its real derivatives; a uv-less
+    /// one gets its frame's unit vectors.
+    #[test]
+    fn placeholder_uvs_with_tangents_are_real_uvs() {
+        let v = [
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 3.0, 0.0),
+        ];
+        let (frame, dp) = triangle_frame(Vec3::Z, &v, &BARYCENTRIC_UVS, Some(Vec3::X));
+        assert_eq!(frame.s, Vec3::X);
+        assert_eq!((dp.dp_du, dp.dp_dv), (v[1], v[2]));
+        let (frame, dp) = triangle_frame(Vec3::Z, &v, &BARYCENTRIC_UVS, None);
+        assert_eq!((dp.dp_du, dp.dp_dv), (frame.s, frame.t));
+    }
+
+    /// At either pole the sphere's tangent is the limit of ∂p/∂u along
+    /// φ = 0, the object's +y; elsewhere it runs along ∂p/∂u.
+    #[test]
+    fn sphere_tangents_at_the_poles_are_the_limit_along_phi_zero() {
+        let rows = [Vec3::X, Vec3::Y, Vec3::Z];
+        for n in [Vec3::Z, Vec3::NEG_Z] {
+            let (frame, _) = sphere_frame(n, n, &rows, 1.0);
+            assert!((frame.s - Vec3::Y).length() < 1e-6, "{n}: {}", frame.s);
+            let near = Vec3::new(1e-3, 0.0, n.z).normalize();
+            let (f, dp) = sphere_frame(near, near, &rows, 1.0);
+            assert!(f.s.dot(Vec3::Y) > 0.999, "{near}: {}", f.s);
+            assert!(dp.dp_du.normalize().dot(f.s) > 0.999);
+        }
     }
 }

@@ -41,8 +41,9 @@ impl<'a> SurfaceBatch<'a> {
         }
     }
 
-    /// The same points seen from directions `wo` (a wrapper's perturbed
-    /// frame): texture coordinates and derivatives are passed on.
+    /// The same points with outgoing directions `wo`; texture coordinates
+    /// and derivatives are passed on as they are, so a wrapper that turns
+    /// the frame must re-express the derivatives itself.
     pub fn with_wo<'b>(&self, wo: &'b [Vec3]) -> SurfaceBatch<'b>
     where
         'a: 'b,

@@ -1,8 +1,10 @@
 //! The `normal_map` shader: wraps a material and replaces its shading
 //! normal by one read from a texture (RGB in [0, 1] encoding a
-//! tangent-space normal as 2·c − 1: +x along ∂p/∂u, +z out of the
-//! surface — uv tangent space, as Mitsuba 3's `normalmap` and normal-map
-//! bakers define it). See [`crate::perturb`] for the frame.
+//! tangent-space normal as 2·c − 1: +x along ∂p/∂u, +y along n × x, +z
+//! out of the surface — uv tangent space as Mitsuba 3's `normalmap` reads
+//! it, which matches bakers' maps except on mirrored uv islands, whose
+//! green comes out inverted, in Mitsuba too). See [`crate::perturb`] for
+//! the frame.
 
 use crate::perturb::{self, NormalSource, PerturbOptions, Perturbed};
 use radiant_core::glam::Vec3;
