@@ -77,3 +77,90 @@ fn a_mesh_with_nothing_usable_is_an_error_with_its_location() {
         "{shown}"
     );
 }
+
+/// Loads (and, past the scene file, extracts) `text` from `dir` and
+/// returns the error it must give.
+fn scene_error(text: &str, dir: &std::path::Path) -> String {
+    let path = std::path::Path::new("bad.yaml");
+    match radiant::scene::from_str(text, path, dir) {
+        Err(e) => e.to_string(),
+        Ok(scene) => extract(&scene, &radiant::builtin_registry(), &Overrides::default())
+            .err()
+            .expect("rejected")
+            .to_string(),
+    }
+}
+
+/// `/dev/zero`, a FIFO and a folder named as a mesh, a texture or an
+/// environment map: each is a located error that says what the path is,
+/// at once (a FIFO would block a reader forever, `/dev/zero` never ends).
+#[test]
+fn special_files_are_located_errors_at_once() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let fifo = dir.path().join("pipe.exr");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success(), "mkfifo failed");
+    let folder = dir.path().join("folder.exr");
+    std::fs::create_dir(&folder).expect("folder");
+    let cases = [
+        ("/dev/zero", "a character device"),
+        (fifo.to_str().expect("utf-8"), "a FIFO"),
+        (folder.to_str().expect("utf-8"), "a folder"),
+    ];
+    let head = "camera: {type: perspective}\n";
+    for (path, kind) in cases {
+        let uses = [
+            (
+                format!("{head}shapes:\n  - {{type: mesh, filename: '{path}'}}\n"),
+                3,
+            ),
+            (
+                format!(
+                    "{head}textures:\n  t: {{type: image, filename: '{path}'}}\nshapes:\n  - {{type: sphere, material: {{type: diffuse, reflectance: t}}}}\n"
+                ),
+                3,
+            ),
+            (
+                format!("{head}lights:\n  - {{type: environment, filename: '{path}'}}\n"),
+                3,
+            ),
+        ];
+        for (text, line) in uses {
+            let start = std::time::Instant::now();
+            let shown = scene_error(&text, dir.path());
+            let took = start.elapsed();
+            assert!(took.as_secs_f64() < 1.0, "{path}: took {took:?}");
+            assert!(
+                shown.starts_with(&format!("bad.yaml:{line}:")),
+                "{path}: {shown}"
+            );
+            assert!(shown.contains(kind), "{path}: {shown}");
+            assert!(shown.contains("not a regular file"), "{path}: {shown}");
+        }
+    }
+}
+
+/// A 100 MB OBJ "line" (a file with no line breaks) is a located error
+/// after the first megabyte, not a 100 MB string.
+#[test]
+fn an_obj_without_line_breaks_is_a_located_error() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let file = std::fs::File::create(dir.path().join("long.obj")).expect("created");
+    file.set_len(100 << 20).expect("100 MB of zero bytes");
+    let text = "camera: {type: perspective}\nshapes:\n  - {type: mesh, filename: long.obj}\n";
+    let start = std::time::Instant::now();
+    let shown = scene_error(text, dir.path());
+    assert!(
+        start.elapsed().as_secs_f64() < 1.0,
+        "took {:?}",
+        start.elapsed()
+    );
+    assert!(shown.starts_with("bad.yaml:3:"), "{shown}");
+    assert!(
+        shown.contains("line 1 is longer than 1048576 bytes"),
+        "{shown}"
+    );
+}

@@ -25,6 +25,7 @@
 
 mod instances;
 mod keyframes;
+pub mod line_limit;
 pub mod obj;
 pub mod tangents;
 pub mod transform;
@@ -69,6 +70,8 @@ const INTEGRATORS: &[&str] = &["path"];
 /// Loads the scene file at `path`.
 pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
     let path = path.as_ref();
+    radiant_core::input_file::check_regular_file(path)
+        .map_err(|e| SceneError::new(path, None, format!("cannot read the scene file: {e}")))?;
     let text = std::fs::read_to_string(path)
         .map_err(|e| SceneError::new(path, None, format!("cannot read the scene file: {e}")))?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();

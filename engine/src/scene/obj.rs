@@ -9,6 +9,7 @@
 //! normal vanishes in single precision. [`MeshRepairs`] counts what was
 //! done; `radiant render` warns about it and `radiant info` reports it.
 
+use super::line_limit::{LineLimit, MAX_LINE};
 use crate::world::{MeshData, MeshRepairs};
 use glam::{DVec3, Vec2, Vec3};
 use std::path::Path;
@@ -90,9 +91,21 @@ fn read_obj(path: &Path, flip_tex_coords: bool) -> Result<MeshData, String> {
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, _materials) = tobj::load_obj(path, &options).map_err(|e| match e {
-        tobj::LoadError::OpenFileFailed => format!("cannot open mesh file `{}`", path.display()),
-        other => format!("cannot read mesh file `{}`: {other}", path.display()),
+    radiant_core::input_file::check_regular_file(path)
+        .map_err(|e| format!("cannot read the mesh file: {e}"))?;
+    let file = std::fs::File::open(path)
+        .map_err(|e| format!("cannot open mesh file `{}`: {e}", path.display()))?;
+    let mut reader = LineLimit::new(std::io::BufReader::new(file), MAX_LINE);
+    // Materials are ignored: an `mtllib` line loads nothing.
+    let loaded = tobj::load_obj_buf(&mut reader, &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    });
+    let (models, _materials) = loaded.map_err(|e| match reader.long_line() {
+        Some(line) => format!(
+            "mesh file `{}`: line {line} is longer than {MAX_LINE} bytes (is it an OBJ file?)",
+            path.display()
+        ),
+        None => format!("cannot read mesh file `{}`: {e}", path.display()),
     })?;
     let mut mesh = MeshData {
         source: path.display().to_string(),

@@ -17,6 +17,9 @@ pub const MAX_EXR_PIXELS: usize = 1 << 28;
 /// Why an EXR file could not be read.
 #[derive(Debug, thiserror::Error)]
 pub enum ExrError {
+    /// The path is not a regular file (a folder, a FIFO, a device).
+    #[error("{0}")]
+    NotRegular(String),
     /// The `exr` crate could not read the file.
     #[error("{0}")]
     Read(#[from] exr::error::Error),
@@ -36,6 +39,7 @@ pub enum ExrError {
 /// The pixels and size of the EXR image at `path`.
 pub fn read_exr_rgb(path: &Path) -> Result<(Vec<Rgb>, UVec2), ExrError> {
     use exr::prelude::read_first_rgba_layer_from_file;
+    crate::input_file::check_regular_file(path).map_err(ExrError::NotRegular)?;
     let meta = exr::meta::MetaData::read_from_file(path, false)?;
     for header in &meta.headers {
         let (width, height) = (header.layer_size.width(), header.layer_size.height());

@@ -27,6 +27,7 @@ pub mod exr_file;
 pub mod filter;
 pub mod frame;
 pub mod hash;
+pub mod input_file;
 pub mod light;
 pub mod params;
 pub mod registry;

@@ -8,6 +8,8 @@ use std::path::Path;
 
 /// Reads the map at `path`; errors name the file and say what is accepted.
 pub(crate) fn load_map(path: &Path) -> Result<(Vec<Rgb>, UVec2), String> {
+    radiant_core::input_file::check_regular_file(path)
+        .map_err(|e| format!("cannot read the environment map: {e}"))?;
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
