@@ -72,6 +72,10 @@ MUTATIONS = [
      "let solid_angle = 1.02 * (g0 + g1 + g2 + g3 - two_pi);"),
     ("aperture+5%", "thin-lens aperture 5 % too large", "modules/cameras/src/thin_lens.rs",
      "square_to_disk_concentric(*u) * self.aperture_radius", "square_to_disk_concentric(*u) * (1.05 * self.aperture_radius)"),
+    ("envmap-lower-pdf+3%", "environment map pdf 3 % too large below the horizon only (both sides)",
+     "modules/lights/src/environment.rs",
+     "self.distribution.pdf(c) / (rows * TAU * band)",
+     "self.distribution.pdf(c) / (rows * TAU * band) * if 2 * c.y > self.size.y { 1.03 } else { 1.0 }"),
     ("srgb-gamma-2.2", "sRGB decoded by a plain 2.2 power", "modules/textures/src/srgb.rs",
      "((c + 0.055) / 1.055).powf(2.4)", "c.powf(2.2)"),
 ]

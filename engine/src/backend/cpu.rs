@@ -69,6 +69,9 @@ pub struct Pass {
     pub rays: u64,
 }
 
+/// Tiles each thread renders per group, at least (see [`render_samples`]).
+const GROUP_TILES_PER_THREAD: usize = 16;
+
 /// Progressive rendering: renders the sample indices `samples` of every
 /// pixel and adds them to `film`. Calling it with consecutive ranges
 /// (`0..4`, `4..8`, …) accumulates the same image as one render of all
@@ -90,40 +93,48 @@ pub fn render_samples(
     let spp = samples.len() as u32;
     let total = w as u64 * h as u64 * spp as u64;
     let done = std::sync::atomic::AtomicU64::new(0);
-    let results: Vec<(TileFilm, u64)> = tiles
-        .par_iter()
-        .map_init(Wavefront::default, |wave, &(x0, y0)| {
-            let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
-            let pixels = (x1 - x0) * (y1 - y0);
-            let chunk = (BATCH_PATHS / pixels).max(1);
-            let mut tile = TileFilm::new(x0, y0, x1, y1, (w, h), reconstruction.reach());
-            let rays_before = wave.rays;
-            let mut first = samples.start;
-            while first < samples.end {
-                let count = chunk.min(samples.end - first);
-                let batch = Batch {
-                    x0,
-                    y0,
-                    x1,
-                    y1,
-                    first_sample: first,
-                    samples: count,
-                };
-                wave.render(scene, batch, &reconstruction, &mut tile);
-                first += count;
-                if let Some(f) = progress.callback {
-                    let n = pixels as u64 * count as u64;
-                    let d = done.fetch_add(n, std::sync::atomic::Ordering::Relaxed) + n;
-                    f(d, total);
-                }
+    let render_tile = |wave: &mut Wavefront, &(x0, y0): &(u32, u32)| {
+        let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
+        let pixels = (x1 - x0) * (y1 - y0);
+        let chunk = (BATCH_PATHS / pixels).max(1);
+        let mut tile = TileFilm::new(x0, y0, x1, y1, (w, h), reconstruction.reach());
+        let rays_before = wave.rays;
+        let mut first = samples.start;
+        while first < samples.end {
+            let count = chunk.min(samples.end - first);
+            let batch = Batch {
+                x0,
+                y0,
+                x1,
+                y1,
+                first_sample: first,
+                samples: count,
+            };
+            wave.render(scene, batch, &reconstruction, &mut tile);
+            first += count;
+            if let Some(f) = progress.callback {
+                let n = pixels as u64 * count as u64;
+                let d = done.fetch_add(n, std::sync::atomic::Ordering::Relaxed) + n;
+                f(d, total);
             }
-            (tile, wave.rays - rays_before)
-        })
-        .collect();
+        }
+        (tile, wave.rays - rays_before)
+    };
+    // Tiles are rendered a group at a time and merged in tile order (so the
+    // image does not depend on the thread count), which keeps the tile
+    // films of one group in memory, not those of the whole image.
+    let group =
+        (w.div_ceil(TILE) as usize).max(GROUP_TILES_PER_THREAD * rayon::current_num_threads());
     let mut rays = 0;
-    for (tile, r) in &results {
-        film.merge(tile);
-        rays += r;
+    for tiles in tiles.chunks(group) {
+        let results: Vec<(TileFilm, u64)> = tiles
+            .par_iter()
+            .map_init(Wavefront::default, render_tile)
+            .collect();
+        for (tile, r) in &results {
+            film.merge(tile);
+            rays += r;
+        }
     }
     Pass {
         time: start.elapsed(),
