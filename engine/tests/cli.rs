@@ -687,3 +687,29 @@ fn a_missing_frame_of_a_deforming_mesh_fails_before_any_frame_renders() {
     );
     assert!(!dir.path().join("f_1.png").exists(), "a frame was written");
 }
+
+/// A frame whose film does not fit under the process's memory limit is
+/// refused before rendering with what it needs and what would fit, exit
+/// code 1 (not an allocation abort's 134), and no output file.
+#[test]
+fn a_frame_larger_than_memory_is_a_clear_error() {
+    let (_dir, out) = temp("huge.exr");
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell-box.yaml");
+    let o = Command::new("prlimit")
+        .arg("--as=1200000000")
+        .arg(env!("CARGO_BIN_EXE_radiant"))
+        .args([
+            "render", scene, "--width", "8192", "--height", "8192", "--spp", "1", "-o",
+        ])
+        .arg(&out)
+        .output()
+        .expect("prlimit (util-linux) runs");
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("a 8192×8192 frame needs 1.75 GiB of memory"),
+        "{err}"
+    );
+    assert!(err.contains("rows at this width"), "{err}");
+    assert!(!out.exists(), "no output may be left behind");
+}

@@ -3,6 +3,7 @@
 //! merged in tile order (so results do not depend on the thread count).
 
 use crate::extract::RenderScene;
+use crate::film::memory::FrameTooLarge;
 use crate::film::{Film, Image, Reconstruction, TileFilm};
 use crate::integrators::path::{Batch, Wavefront};
 use rayon::prelude::*;
@@ -45,17 +46,29 @@ pub struct Rendered {
 }
 
 /// Renders `scene` on all threads of the current rayon pool.
+///
+/// # Panics
+///
+/// Where the frame's film cannot be allocated; [`try_render`] reports
+/// that instead.
 pub fn render(scene: &RenderScene, progress: &Progress<'_>) -> Rendered {
+    try_render(scene, progress).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Renders `scene` as [`render`] does, or says what the frame needed where
+/// its film cannot be allocated (before any sample is traced).
+pub fn try_render(scene: &RenderScene, progress: &Progress<'_>) -> Result<Rendered, FrameTooLarge> {
     let s = &scene.settings;
-    let mut film = Film::new(s.width, s.height);
+    let mut film = Film::try_new(s.width, s.height)?;
     let pass = render_samples(scene, &mut film, 0..s.spp, progress);
-    Rendered {
-        image: film.develop(),
+    let image = film.try_develop()?;
+    Ok(Rendered {
+        image,
         time: pass.time,
         samples: pass.samples,
         rays: pass.rays,
         invalid_samples: film.invalid_samples,
-    }
+    })
 }
 
 /// What one call of [`render_samples`] did.

@@ -9,6 +9,7 @@
 //! filter's reach ([`FilterTable`]), or placed by filter importance
 //! sampling and added to one pixel ([`FilterSampler`], pbrt-v4).
 
+pub mod memory;
 pub mod output;
 pub mod sheet;
 
@@ -284,13 +285,31 @@ pub struct Film {
 
 impl Film {
     /// An empty film.
+    ///
+    /// # Panics
+    ///
+    /// Where its memory cannot be allocated; [`Film::try_new`] reports
+    /// that instead.
     pub fn new(width: u32, height: u32) -> Self {
-        Self {
+        Self::try_new(width, height).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// An empty film, or what it needed where its memory (with that of the
+    /// image it develops into) cannot be reserved.
+    pub fn try_new(width: u32, height: u32) -> Result<Self, memory::FrameTooLarge> {
+        let too_large = || memory::FrameTooLarge {
             width,
             height,
-            sums: vec![Vec4::ZERO; (width * height) as usize],
+            available: memory::available_memory(),
+        };
+        let pixels = width as usize * height as usize;
+        let sums = memory::try_filled(pixels, Vec4::ZERO).ok_or_else(too_large)?;
+        Ok(Self {
+            width,
+            height,
+            sums,
             invalid_samples: 0,
-        }
+        })
     }
 
     /// Adds a tile's sums.
@@ -306,22 +325,38 @@ impl Film {
     }
 
     /// The reconstructed image: Σ w·L / Σ w per pixel.
+    ///
+    /// # Panics
+    ///
+    /// Where its memory cannot be allocated; [`Film::try_develop`] reports
+    /// that instead.
     pub fn develop(&self) -> Image {
-        Image {
+        self.try_develop().unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// The reconstructed image, or what the frame needed where its memory
+    /// cannot be reserved.
+    pub fn try_develop(&self) -> Result<Image, memory::FrameTooLarge> {
+        let mut pixels = Vec::new();
+        if pixels.try_reserve_exact(self.sums.len()).is_err() {
+            return Err(memory::FrameTooLarge {
+                width: self.width,
+                height: self.height,
+                available: memory::available_memory(),
+            });
+        }
+        pixels.extend(self.sums.iter().map(|s| {
+            if s.w > 0.0 {
+                s.truncate() / s.w
+            } else {
+                Rgb::ZERO
+            }
+        }));
+        Ok(Image {
             width: self.width,
             height: self.height,
-            pixels: self
-                .sums
-                .iter()
-                .map(|s| {
-                    if s.w > 0.0 {
-                        s.truncate() / s.w
-                    } else {
-                        Rgb::ZERO
-                    }
-                })
-                .collect(),
-        }
+            pixels,
+        })
     }
 }
 
