@@ -28,21 +28,10 @@ impl Lcg {
 /// The closed cube [-1,1]³ scaled by `scale` and moved to `offset`, as
 /// 12 triangles with outward normals.
 fn cube(scale: f32, offset: Vec3) -> Vec<Primitive> {
-    let faces = [
-        (Vec3::X, Vec3::Y, Vec3::Z),
-        (Vec3::NEG_X, Vec3::Z, Vec3::Y),
-        (Vec3::Y, Vec3::Z, Vec3::X),
-        (Vec3::NEG_Y, Vec3::X, Vec3::Z),
-        (Vec3::Z, Vec3::X, Vec3::Y),
-        (Vec3::NEG_Z, Vec3::Y, Vec3::X),
-    ];
-    let mut prims = Vec::new();
-    for (n, u, v) in faces {
-        let c = [n - u - v, n + u - v, n + u + v, n - u + v].map(|p| p * scale + offset);
-        prims.push(Primitive::Triangle([c[0], c[1], c[2]]));
-        prims.push(Primitive::Triangle([c[0], c[2], c[3]]));
-    }
-    prims
+    radiant_tests::box_triangles(Vec3::splat(scale), offset)
+        .into_iter()
+        .map(Primitive::Triangle)
+        .collect()
 }
 
 /// Hit point, error bound and geometric normal of a triangle hit.

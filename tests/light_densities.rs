@@ -159,23 +159,8 @@ fn rectangle() -> EmitterShape {
 
 /// A box of six rectangles, as a `cube` shape makes it.
 fn cube() -> EmitterShape {
-    let faces = [
-        (Vec3::X, Vec3::Y, Vec3::Z),
-        (Vec3::NEG_X, Vec3::Z, Vec3::Y),
-        (Vec3::Y, Vec3::Z, Vec3::X),
-        (Vec3::NEG_Y, Vec3::X, Vec3::Z),
-        (Vec3::Z, Vec3::X, Vec3::Y),
-        (Vec3::NEG_Z, Vec3::Y, Vec3::X),
-    ];
-    let scale = Vec3::new(0.5, 1.0, 0.25);
-    let mut triangles = Vec::new();
-    for (n, u, v) in faces {
-        let c = [n - u - v, n + u - v, n + u + v, n - u + v].map(|p| p * scale);
-        triangles.push([c[0], c[1], c[2]]);
-        triangles.push([c[0], c[2], c[3]]);
-    }
     EmitterShape {
-        triangles,
+        triangles: radiant_tests::box_triangles(Vec3::new(0.5, 1.0, 0.25), Vec3::ZERO),
         spheres: vec![],
     }
 }

@@ -20,7 +20,6 @@
 
 use glam::{Vec2, Vec3};
 use radiant::backend::cpu::{Progress, render};
-use radiant::core::CameraRays;
 use radiant::extract::{Overrides, RenderScene, extract};
 use radiant::film::Image;
 use std::f32::consts::PI;
@@ -49,22 +48,8 @@ fn pixel_rays(scene: &RenderScene, eye: Vec3, n: u32) -> Vec<(Vec3, Vec3)> {
             }
         }
     }
-    let lens = vec![Vec2::splat(0.5); film.len()];
-    let mut origins = vec![Vec3::ZERO; film.len()];
-    let mut directions = vec![Vec3::ZERO; film.len()];
-    let mut weights = vec![0.0; film.len()];
-    scene.camera.generate(
-        &film,
-        &lens,
-        CameraRays {
-            origins: &mut origins,
-            directions: &mut directions,
-            weights: &mut weights,
-        },
-    );
-    origins
+    radiant_tests::camera_rays(scene, &film)
         .into_iter()
-        .zip(directions)
         .map(|(o, d)| (o + eye, d))
         .collect()
 }

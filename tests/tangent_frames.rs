@@ -11,14 +11,14 @@
 use glam::{Vec2, Vec3};
 use radiant::backend::cpu::{Progress, render};
 use radiant::core::{
-    BsdfEval, BsdfSample, BuildContext, CameraRays, Effects, ModuleInfo, ParamDoc, ParamError,
-    Params, ShadeContext, Shader, SurfaceBatch,
+    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamDoc, ParamError, Params,
+    ShadeContext, Shader, SurfaceBatch,
 };
 use radiant::extract::{Overrides, RenderScene, extract};
 use radiant::film::Image;
 use radiant::film::output::read_exr;
 use radiant::integrators::surface::interaction_with_derivatives;
-use radiant_tests::block_channel_means;
+use radiant_tests::{block_channel_means, camera_rays};
 
 /// The local shading frame turned 90° about the normal: what a renderer
 /// whose tangents are off by a quarter turn would hand the material.
@@ -191,24 +191,9 @@ fn mesh_tangents_are_orthonormal_and_continuous() {
     let film: Vec<Vec2> = (0..steps)
         .map(|i| Vec2::new(72.0 + 48.0 * i as f32 / steps as f32, 29.5))
         .collect();
-    let lens = vec![Vec2::splat(0.5); steps];
-    let (mut origins, mut directions, mut weights) = (
-        vec![Vec3::ZERO; steps],
-        vec![Vec3::ZERO; steps],
-        vec![0.0; steps],
-    );
-    scene.camera.generate(
-        &film,
-        &lens,
-        CameraRays {
-            origins: &mut origins,
-            directions: &mut directions,
-            weights: &mut weights,
-        },
-    );
     let mut previous: Option<(Vec3, Vec3)> = None;
     let mut triangles = std::collections::BTreeSet::new();
-    for (&o, &d) in origins.iter().zip(&directions) {
+    for (o, d) in camera_rays(&scene, &film) {
         let Some(hit) = scene.accel.intersect(o, d, f32::INFINITY) else {
             previous = None;
             continue;

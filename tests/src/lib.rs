@@ -59,6 +59,51 @@ pub fn render_checked(scene: &str, overrides: Overrides) -> Image {
     image
 }
 
+/// The primary rays (origin, unit direction; render space) of `scene`'s
+/// camera through the film positions `film` (raster pixels), with the lens
+/// sample at the aperture's centre.
+pub fn camera_rays(
+    scene: &radiant::extract::RenderScene,
+    film: &[glam::Vec2],
+) -> Vec<(glam::Vec3, glam::Vec3)> {
+    use glam::{Vec2, Vec3};
+    let n = film.len();
+    let lens = vec![Vec2::splat(0.5); n];
+    let (mut origins, mut directions, mut weights) =
+        (vec![Vec3::ZERO; n], vec![Vec3::ZERO; n], vec![0.0; n]);
+    scene.camera.generate(
+        film,
+        &lens,
+        radiant_core::CameraRays {
+            origins: &mut origins,
+            directions: &mut directions,
+            weights: &mut weights,
+        },
+    );
+    origins.into_iter().zip(directions).collect()
+}
+
+/// The closed box [-1, 1]³ scaled by `scale` and moved to `offset`, as 12
+/// triangles (two per face, corners in order) with outward normals.
+pub fn box_triangles(scale: glam::Vec3, offset: glam::Vec3) -> Vec<[glam::Vec3; 3]> {
+    use glam::Vec3;
+    let faces = [
+        (Vec3::X, Vec3::Y, Vec3::Z),
+        (Vec3::NEG_X, Vec3::Z, Vec3::Y),
+        (Vec3::Y, Vec3::Z, Vec3::X),
+        (Vec3::NEG_Y, Vec3::X, Vec3::Z),
+        (Vec3::Z, Vec3::X, Vec3::Y),
+        (Vec3::NEG_Z, Vec3::Y, Vec3::X),
+    ];
+    let mut triangles = Vec::new();
+    for (n, u, v) in faces {
+        let c = [n - u - v, n + u - v, n + u + v, n - u + v].map(|p| p * scale + offset);
+        triangles.push([c[0], c[1], c[2]]);
+        triangles.push([c[0], c[2], c[3]]);
+    }
+    triangles
+}
+
 /// Mean of each colour channel.
 pub fn channel_means(image: &Image) -> [f64; 3] {
     let mut m = [0.0f64; 3];
