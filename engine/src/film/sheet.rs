@@ -17,7 +17,7 @@ fn read_frame(path: &Path) -> Result<RgbImage, ImageError> {
         path: path.display().to_string(),
         message: e.to_string(),
     };
-    radiant_core::input_file::check_regular_file(path).map_err(|e| err(&e))?;
+    radiant_core::input_file::reject_special_file(path).map_err(|e| err(&e))?;
     let is_exr = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"));

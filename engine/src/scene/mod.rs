@@ -70,7 +70,7 @@ const INTEGRATORS: &[&str] = &["path"];
 /// Loads the scene file at `path`.
 pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
     let path = path.as_ref();
-    radiant_core::input_file::check_regular_file(path)
+    radiant_core::input_file::reject_special_file(path)
         .map_err(|e| SceneError::new(path, None, format!("cannot read the scene file: {e}")))?;
     let text = std::fs::read_to_string(path)
         .map_err(|e| SceneError::new(path, None, format!("cannot read the scene file: {e}")))?;

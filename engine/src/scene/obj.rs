@@ -91,12 +91,8 @@ fn read_obj(path: &Path, flip_tex_coords: bool) -> Result<MeshData, String> {
         ignore_points: true,
         ignore_lines: true,
     };
-    // What an existing path is comes first (a FIFO would block the reader,
-    // a device never ends); a missing one fails to open below.
-    if path.exists() {
-        radiant_core::input_file::check_regular_file(path)
-            .map_err(|e| format!("cannot read the mesh file: {e}"))?;
-    }
+    radiant_core::input_file::reject_special_file(path)
+        .map_err(|e| format!("cannot read the mesh file: {e}"))?;
     let file = std::fs::File::open(path)
         .map_err(|e| format!("cannot open mesh file `{}`: {e}", path.display()))?;
     let mut reader = LineLimit::new(std::io::BufReader::new(file), MAX_LINE);

@@ -39,7 +39,7 @@ pub enum ExrError {
 /// The pixels and size of the EXR image at `path`.
 pub fn read_exr_rgb(path: &Path) -> Result<(Vec<Rgb>, UVec2), ExrError> {
     use exr::prelude::read_first_rgba_layer_from_file;
-    crate::input_file::check_regular_file(path).map_err(ExrError::NotRegular)?;
+    crate::input_file::reject_special_file(path).map_err(ExrError::NotRegular)?;
     let meta = exr::meta::MetaData::read_from_file(path, false)?;
     for header in &meta.headers {
         let (width, height) = (header.layer_size.width(), header.layer_size.height());

@@ -21,6 +21,17 @@ pub fn check_regular_file(path: &Path) -> Result<(), String> {
     ))
 }
 
+/// `Ok` if `path` is a regular file or does not exist (its reader then
+/// reports the missing file in its own words), else as
+/// [`check_regular_file`]: for loaders that open the file right after.
+pub fn reject_special_file(path: &Path) -> Result<(), String> {
+    if path.exists() {
+        check_regular_file(path)
+    } else {
+        Ok(())
+    }
+}
+
 /// What a non-regular file is, with its article.
 fn kind_of(meta: &std::fs::Metadata) -> &'static str {
     if meta.is_dir() {

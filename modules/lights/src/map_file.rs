@@ -8,12 +8,8 @@ use std::path::Path;
 
 /// Reads the map at `path`; errors name the file and say what is accepted.
 pub(crate) fn load_map(path: &Path) -> Result<(Vec<Rgb>, UVec2), String> {
-    // What an existing path is comes first (a FIFO would block the
-    // reader); a missing one is reported by the reader with the name rule.
-    if path.exists() {
-        radiant_core::input_file::check_regular_file(path)
-            .map_err(|e| format!("cannot read the environment map: {e}"))?;
-    }
+    radiant_core::input_file::reject_special_file(path)
+        .map_err(|e| format!("cannot read the environment map: {e}"))?;
     let ext = path
         .extension()
         .and_then(|e| e.to_str())

@@ -96,7 +96,7 @@ fn load_exr(path: &Path) -> Result<Texels, LoadError> {
 }
 
 fn load_image(path: &Path, raw: bool) -> Result<Texels, LoadError> {
-    radiant_core::input_file::check_regular_file(path).map_err(|e| read_error(path, e))?;
+    radiant_core::input_file::reject_special_file(path).map_err(|e| read_error(path, e))?;
     let decoded = image::ImageReader::open(path)
         .map_err(|e| read_error(path, e))?
         .with_guessed_format()
