@@ -157,7 +157,7 @@ def write_report(head, whole, rows, seconds):
         f"# Mutation check of commit {head[:10]}",
         "",
         f"`python3 tests/mutations/mutate.py{' --all' if whole else ''}`: "
-        f"{len(rows)} mutations so far, {seconds:.0f} s.",
+        f"{len(rows)} mutations, {seconds:.0f} s.",
         "",
         "| mutation | bias | verdict | failing tests |",
         "| --- | --- | --- | --- |",
