@@ -9,6 +9,9 @@
 //! no ray can hit, must return density 1 and the radiance their formulas
 //! give.
 
+// `unwrap` in this test code is the assertion: the inputs are the test's
+// own, so a failure is a bug, and the panic reports it with the error.
+
 use glam::{Mat3, UVec2, Vec2, Vec3};
 use radiant_core::{
     BoundingSphere, EmitterEval, EmitterHit, EmitterShape, Light, LightSample, Rgb,

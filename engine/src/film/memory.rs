@@ -26,6 +26,16 @@ pub struct FrameTooLarge {
 }
 
 impl FrameTooLarge {
+    /// The error for a `width`×`height` frame, with the memory available
+    /// now.
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            available: available_memory(),
+        }
+    }
+
     /// Bytes the frame needs: its sums and its developed image.
     pub fn needed(&self) -> u64 {
         self.width as u64 * self.height as u64 * (SUM_BYTES + IMAGE_BYTES)

@@ -297,13 +297,9 @@ impl Film {
     /// An empty film, or what it needed where its memory (with that of the
     /// image it develops into) cannot be reserved.
     pub fn try_new(width: u32, height: u32) -> Result<Self, memory::FrameTooLarge> {
-        let too_large = || memory::FrameTooLarge {
-            width,
-            height,
-            available: memory::available_memory(),
-        };
         let pixels = width as usize * height as usize;
-        let sums = memory::try_filled(pixels, Vec4::ZERO).ok_or_else(too_large)?;
+        let sums = memory::try_filled(pixels, Vec4::ZERO)
+            .ok_or_else(|| memory::FrameTooLarge::new(width, height))?;
         Ok(Self {
             width,
             height,
@@ -339,11 +335,7 @@ impl Film {
     pub fn try_develop(&self) -> Result<Image, memory::FrameTooLarge> {
         let mut pixels = Vec::new();
         if pixels.try_reserve_exact(self.sums.len()).is_err() {
-            return Err(memory::FrameTooLarge {
-                width: self.width,
-                height: self.height,
-                available: memory::available_memory(),
-            });
+            return Err(memory::FrameTooLarge::new(self.width, self.height));
         }
         pixels.extend(self.sums.iter().map(|s| {
             if s.w > 0.0 {

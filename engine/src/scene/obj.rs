@@ -214,6 +214,8 @@ fn repair_attributes(mesh: &mut MeshData) {
 
 #[cfg(test)]
 mod tests {
+    // `unwrap` in this test code is the assertion: the inputs are the test's
+    // own, so a failure is a bug, and the panic reports it with the error.
     use super::*;
     use std::io::Write;
 

@@ -1,34 +1,22 @@
 //! Input files a scene names (meshes, textures, environment maps,
 //! references, the scene itself) must be regular files: a FIFO would block
 //! the reader forever, a device such as `/dev/zero` never ends, and a
-//! folder cannot be read. [`check_regular_file`] says which of these a
+//! folder cannot be read. [`reject_special_file`] says which of these a
 //! path is before anything opens it; the loaders call it first.
 
 use std::path::Path;
 
-/// `Ok` if `path` names a regular file (through symbolic links), else a
-/// sentence that names the path and says what it is instead.
-pub fn check_regular_file(path: &Path) -> Result<(), String> {
-    let meta =
-        std::fs::metadata(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
-    if meta.is_file() {
-        return Ok(());
-    }
-    Err(format!(
-        "`{}` is {}, not a regular file",
-        path.display(),
-        kind_of(&meta)
-    ))
-}
-
-/// `Ok` if `path` is a regular file or does not exist (its reader then
-/// reports the missing file in its own words), else as
-/// [`check_regular_file`]: for loaders that open the file right after.
+/// `Ok` if `path` is a regular file (through symbolic links) or cannot be
+/// looked at (missing: its reader then reports that in its own words),
+/// else a sentence that names the path and says what it is instead.
 pub fn reject_special_file(path: &Path) -> Result<(), String> {
-    if path.exists() {
-        check_regular_file(path)
-    } else {
-        Ok(())
+    match std::fs::metadata(path) {
+        Ok(meta) if !meta.is_file() => Err(format!(
+            "`{}` is {}, not a regular file",
+            path.display(),
+            kind_of(&meta)
+        )),
+        _ => Ok(()),
     }
 }
 
@@ -66,19 +54,16 @@ mod tests {
         let dir = std::env::temp_dir();
         let file = dir.join(format!("radiant-input-{}.txt", std::process::id()));
         std::fs::write(&file, "x").expect("temp file");
-        assert_eq!(check_regular_file(&file), Ok(()));
+        assert_eq!(reject_special_file(&file), Ok(()));
         std::fs::remove_file(&file).expect("removed");
-        let folder = check_regular_file(&dir).expect_err("a folder");
+        let folder = reject_special_file(&dir).expect_err("a folder");
         assert!(folder.contains("is a folder"), "{folder}");
         #[cfg(unix)]
         {
-            let zero = check_regular_file(Path::new("/dev/zero")).expect_err("a device");
+            let zero = reject_special_file(Path::new("/dev/zero")).expect_err("a device");
             assert!(zero.contains("character device"), "{zero}");
         }
-        let missing = check_regular_file(Path::new("/nonexistent/x.obj")).expect_err("missing");
-        assert!(
-            missing.contains("cannot read `/nonexistent/x.obj`"),
-            "{missing}"
-        );
+        // A missing file is left to its reader.
+        assert_eq!(reject_special_file(Path::new("/nonexistent/x.obj")), Ok(()));
     }
 }
