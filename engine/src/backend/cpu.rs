@@ -2,9 +2,10 @@
 //! rendered as wavefront batches on a rayon worker, and tile films are
 //! merged in tile order (so results do not depend on the thread count).
 
+pub use super::{Progress, Rendered};
 use crate::extract::RenderScene;
 use crate::film::memory::FrameTooLarge;
-use crate::film::{Film, Image, Reconstruction, TileFilm};
+use crate::film::{Film, Reconstruction, TileFilm};
 use crate::integrators::path::{Batch, Wavefront};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -13,37 +14,6 @@ use std::time::{Duration, Instant};
 const TILE: u32 = 16;
 /// Paths per wavefront batch (about): a tile's pixels × a few samples.
 const BATCH_PATHS: u32 = 1024;
-
-/// Receives progress as tiles finish.
-pub struct Progress<'a> {
-    callback: Option<&'a (dyn Fn(u64, u64) + Sync)>,
-}
-
-impl<'a> Progress<'a> {
-    /// No progress reporting.
-    pub fn none() -> Self {
-        Self { callback: None }
-    }
-
-    /// Calls `f(done, total)` (in samples) as work finishes.
-    pub fn new(f: &'a (dyn Fn(u64, u64) + Sync)) -> Self {
-        Self { callback: Some(f) }
-    }
-}
-
-/// A finished render.
-pub struct Rendered {
-    /// The developed image.
-    pub image: Image,
-    /// Wall time of the rendering (extract and BVH excluded).
-    pub time: Duration,
-    /// Camera paths traced (pixels × spp).
-    pub samples: u64,
-    /// Rays traced (camera, continuation and shadow rays).
-    pub rays: u64,
-    /// Samples that were NaN or infinite and recorded as zero.
-    pub invalid_samples: u64,
-}
 
 /// Renders `scene` on all threads of the current rayon pool.
 ///
@@ -125,10 +95,10 @@ pub fn render_samples(
             };
             wave.render(scene, batch, &reconstruction, &mut tile);
             first += count;
-            if let Some(f) = progress.callback {
+            if progress.is_active() {
                 let n = pixels as u64 * count as u64;
                 let d = done.fetch_add(n, std::sync::atomic::Ordering::Relaxed) + n;
-                f(d, total);
+                progress.report(d, total);
             }
         }
         (tile, wave.rays - rays_before)
@@ -159,6 +129,7 @@ pub fn render_samples(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::film::Image;
     use crate::extract::{Overrides, extract};
     use std::path::Path;
 

@@ -1,4 +1,166 @@
-//! Backends run the integrator over the frame. [`cpu`] uses every core
-//! through rayon.
+//! Backends render an extracted frame. [`cpu`] runs the wavefront path
+//! tracer on every core through rayon; [`gpu`] runs it as a wgpu compute
+//! kernel assembled from the frame's modules. [`Backend`] is the seam the
+//! command line renders through, and [`choose`] picks one as
+//! `--backend cpu|gpu|auto` asks.
 
 pub mod cpu;
+pub mod gpu;
+
+use crate::extract::RenderScene;
+use crate::film::Image;
+use crate::film::memory::FrameTooLarge;
+use std::time::Duration;
+use thiserror::Error;
+
+/// Receives progress as tiles finish.
+pub struct Progress<'a> {
+    callback: Option<&'a (dyn Fn(u64, u64) + Sync)>,
+}
+
+impl<'a> Progress<'a> {
+    /// No progress reporting.
+    pub fn none() -> Self {
+        Self { callback: None }
+    }
+
+    /// Calls `f(done, total)` (in samples) as work finishes.
+    pub fn new(f: &'a (dyn Fn(u64, u64) + Sync)) -> Self {
+        Self { callback: Some(f) }
+    }
+
+    /// Whether anyone listens.
+    pub fn is_active(&self) -> bool {
+        self.callback.is_some()
+    }
+
+    /// Reports `done` of `total` samples.
+    pub fn report(&self, done: u64, total: u64) {
+        if let Some(f) = self.callback {
+            f(done, total);
+        }
+    }
+}
+
+/// A finished render.
+pub struct Rendered {
+    /// The developed image.
+    pub image: Image,
+    /// Wall time of the rendering (extract and BVH excluded).
+    pub time: Duration,
+    /// Camera paths traced (pixels × spp).
+    pub samples: u64,
+    /// Rays traced (camera, continuation and shadow rays).
+    pub rays: u64,
+    /// Samples that were NaN or infinite and recorded as zero.
+    pub invalid_samples: u64,
+}
+
+/// Why a backend could not render a frame.
+#[derive(Debug, Error)]
+pub enum RenderError {
+    /// The film does not fit in memory.
+    #[error(transparent)]
+    Memory(#[from] FrameTooLarge),
+    /// The GPU failed or cannot render the scene.
+    #[error(transparent)]
+    Gpu(#[from] gpu::GpuError),
+}
+
+/// Something that renders frames: the CPU path tracer or the GPU one.
+pub trait Backend: Send {
+    /// What renders (for messages): `cpu (16 threads)`, an adapter's name.
+    fn describe(&self) -> String;
+
+    /// Renders all samples of `scene` and develops the image.
+    fn render(
+        &mut self,
+        scene: &RenderScene,
+        progress: &Progress<'_>,
+    ) -> Result<Rendered, RenderError>;
+}
+
+/// The CPU backend on the current rayon pool.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct CpuBackend;
+
+impl Backend for CpuBackend {
+    fn describe(&self) -> String {
+        format!("cpu ({} threads)", rayon::current_num_threads())
+    }
+
+    fn render(
+        &mut self,
+        scene: &RenderScene,
+        progress: &Progress<'_>,
+    ) -> Result<Rendered, RenderError> {
+        Ok(cpu::try_render(scene, progress)?)
+    }
+}
+
+impl Backend for gpu::GpuBackend {
+    fn describe(&self) -> String {
+        format!("gpu: {}", self.adapter())
+    }
+
+    fn render(
+        &mut self,
+        scene: &RenderScene,
+        progress: &Progress<'_>,
+    ) -> Result<Rendered, RenderError> {
+        Ok(gpu::GpuBackend::render(self, scene, progress)?)
+    }
+}
+
+/// Which backend renders (`--backend`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum BackendKind {
+    /// The CPU path tracer.
+    Cpu,
+    /// The GPU path tracer; fails where no adapter is found or the scene
+    /// uses a module without GPU code.
+    Gpu,
+    /// The GPU where a hardware adapter is found and the scene has GPU
+    /// code for all its modules, else the CPU (saying why on stderr).
+    #[default]
+    Auto,
+}
+
+/// The backend `kind` asks for, for frames like `scene`; `note` receives
+/// what `auto` chose and why.
+pub fn choose(
+    kind: BackendKind,
+    scene: &RenderScene,
+    note: &mut dyn FnMut(String),
+) -> Result<Box<dyn Backend>, gpu::GpuError> {
+    match kind {
+        BackendKind::Cpu => Ok(Box::new(CpuBackend)),
+        BackendKind::Gpu => {
+            gpu::Plan::new(scene)?;
+            Ok(Box::new(gpu::GpuBackend::new(&gpu::GpuOptions::default())?))
+        }
+        BackendKind::Auto => {
+            if let Err(e) = gpu::Plan::new(scene) {
+                note(format!("backend: cpu ({e})"));
+                return Ok(Box::new(CpuBackend));
+            }
+            match gpu::GpuBackend::new(&gpu::GpuOptions::default()) {
+                Ok(g) if !g.is_software() => {
+                    note(format!("backend: gpu, adapter {}", g.adapter()));
+                    Ok(Box::new(g))
+                }
+                Ok(g) => {
+                    note(format!(
+                        "backend: cpu (the only GPU adapter, {}, is a software one; `--backend gpu` uses it anyway)",
+                        g.adapter()
+                    ));
+                    Ok(Box::new(CpuBackend))
+                }
+                Err(e) => {
+                    note(format!("backend: cpu ({e})"));
+                    Ok(Box::new(CpuBackend))
+                }
+            }
+        }
+    }
+}

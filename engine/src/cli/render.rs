@@ -6,7 +6,7 @@ use super::film_args::FilmArgs;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use radiant::Registry;
-use radiant::backend::cpu::{self, Progress};
+use radiant::backend::{Backend, BackendKind, Progress, choose};
 use radiant::extract::{Overrides, Sequence, SequenceOptions};
 use radiant::world::systems::substitute_frame;
 use std::path::{Path, PathBuf};
@@ -44,6 +44,11 @@ pub struct RenderArgs {
     /// Sampler seed (of the scene's first frame; the others derive theirs).
     #[arg(long)]
     seed: Option<u64>,
+    /// Which backend renders: `gpu` (fails where there is no adapter or a
+    /// module lacks GPU code), `cpu`, or `auto` (the GPU where a hardware
+    /// adapter can render the scene, else the CPU; says which on stderr).
+    #[arg(long, value_enum, default_value_t = BackendKind::Auto)]
+    backend: BackendKind,
     #[command(flatten)]
     film: FilmArgs,
 }
@@ -172,6 +177,7 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
     let started = Instant::now();
     let mut state: Option<Sequence> = None;
     let mut bar: Option<ProgressBar> = None;
+    let mut backend: Option<Box<dyn Backend>> = None;
     for &frame in &todo {
         let update = match &mut state {
             None => {
@@ -188,6 +194,13 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         };
         let s = state.as_ref().expect("built above").scene();
         let settings = &s.settings;
+        let backend = match &mut backend {
+            Some(b) => b,
+            None => backend.insert(
+                choose(args.backend, s, &mut |note| eprintln!("{note}"))
+                    .map_err(|e| miette::miette!("{e}"))?,
+            ),
+        };
         let per_frame = settings.width as u64 * settings.height as u64 * settings.spp as u64;
         let bar = bar.get_or_insert_with(|| {
             let bar = ProgressBar::new(per_frame * todo.len() as u64);
@@ -203,7 +216,7 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         let base = totals.frames * per_frame;
         let progress = |done: u64, _total: u64| bar.set_position(base + done);
         let rendered = pool
-            .install(|| cpu::try_render(s, &Progress::new(&progress)))
+            .install(|| backend.render(s, &Progress::new(&progress)))
             .map_err(|e| miette::miette!("{e}"))?;
         let path = frame_path(&args.output, frame);
         radiant::film::output::write(&path, &rendered.image).map_err(|e| miette::miette!("{e}"))?;

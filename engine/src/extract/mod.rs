@@ -128,8 +128,12 @@ pub struct RenderScene {
     pub shaders: Vec<Box<dyn Shader>>,
     /// Material names, per material index.
     pub material_names: Vec<String>,
+    /// Material module types, per material index.
+    pub material_types: Vec<String>,
     /// The lights.
     pub lights: LightTable,
+    /// Light module types, per light index.
+    pub light_types: Vec<String>,
     /// The camera.
     pub camera: Box<dyn Camera>,
     /// How camera rays move while the shutter is open: the transform from

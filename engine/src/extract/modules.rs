@@ -53,6 +53,22 @@ enum Source {
     },
 }
 
+impl Source {
+    /// The light's module type.
+    fn type_name(&self, scene: &Scene) -> String {
+        let world = &scene.world;
+        let name = match self {
+            Source::Emitter { entity, .. } => world
+                .get::<&EmitterSpec>(*entity)
+                .map(|s| s.0.type_name.clone()),
+            Source::Free { entity, .. } => world
+                .get::<&LightSpec>(*entity)
+                .map(|s| s.0.type_name.clone()),
+        };
+        name.unwrap_or_default()
+    }
+}
+
 /// The module instances' state across frames.
 pub(super) struct ModuleState {
     textures: Vec<Built>,
@@ -267,6 +283,11 @@ impl ModuleState {
             modules,
         };
         Ok((state, initial))
+    }
+
+    /// Each light's module type, by light index.
+    pub(super) fn light_types(&self, scene: &Scene) -> Vec<String> {
+        self.lights.iter().map(|s| s.type_name(scene)).collect()
     }
 
     /// Rebuilds what changed since the last frame in `render`: textures

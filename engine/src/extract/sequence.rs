@@ -203,6 +203,12 @@ pub(super) fn build(
         instance_material,
         shaders: initial.shaders,
         material_names: scene.materials.iter().map(|(n, _)| n.clone()).collect(),
+        material_types: scene
+            .materials
+            .iter()
+            .map(|(_, spec)| spec.type_name.clone())
+            .collect(),
+        light_types: modules.light_types(scene),
         lights: initial.lights,
         camera: initial.camera,
         camera_motion: camera_motion(scene, render_origin),

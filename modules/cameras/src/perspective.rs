@@ -3,8 +3,8 @@
 use crate::projection::{
     FOV_AXIS_DOC, FOV_DOC, FovAxis, InvalidParam, Pinhole, central_rays, default_fov,
 };
-use radiant_core::glam::{Mat4, Vec2};
-use radiant_core::{Camera, CameraRays, ParamDoc, Registry};
+use radiant_core::glam::{Mat4, Vec2, Vec3};
+use radiant_core::{Camera, CameraRays, GpuModule, GpuParams, ParamDoc, Registry};
 use serde::Deserialize;
 
 #[derive(Debug, Deserialize)]
@@ -46,6 +46,20 @@ impl Camera for Perspective {
         central_rays(&self.to_render, film, out, |p| {
             self.pinhole.plane_point(p).extend(1.0)
         });
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let m = self.to_render;
+        let params = GpuParams::new()
+            .vec3(m.transform_point3(Vec3::ZERO))
+            .vec3(m.x_axis.truncate())
+            .vec3(m.y_axis.truncate())
+            .vec3(m.z_axis.truncate());
+        Some(GpuModule::new(
+            "perspective",
+            include_str!("perspective.wgsl"),
+            self.pinhole.gpu_params(params),
+        ))
     }
 }
 

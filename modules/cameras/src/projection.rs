@@ -7,7 +7,7 @@
 //! coordinates* in [−1, 1]² (+x right, +y up) first.
 
 use radiant_core::glam::{Mat4, Vec2, Vec3};
-use radiant_core::{CameraRays, ParamDoc, ParamError, Params};
+use radiant_core::{CameraRays, GpuParams, ParamDoc, ParamError, Params};
 use serde::Deserialize;
 use std::fmt;
 
@@ -115,6 +115,16 @@ impl Pinhole {
     /// The camera-space point (x, y) on the plane z = 1 that raster
     /// position `p` looks through.
     #[inline]
+    /// Appends what `pinhole_plane_point` in WGSL reads: the raster scale,
+    /// then tan(fov/2) per axis.
+    pub(crate) fn gpu_params(&self, params: GpuParams) -> GpuParams {
+        params
+            .f32(self.raster.scale.x)
+            .f32(self.raster.scale.y)
+            .f32(self.tan_half.x)
+            .f32(self.tan_half.y)
+    }
+
     pub(crate) fn plane_point(&self, p: Vec2) -> Vec2 {
         let ndc = self.raster.ndc(p);
         // Camera space +x is left, NDC +x is right.

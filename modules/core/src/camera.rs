@@ -6,7 +6,7 @@
 //! shifted so that the camera's pose origin is at 0, see
 //! [`BuildContext::camera_to_render`](crate::BuildContext)).
 
-use crate::Effects;
+use crate::{Effects, GpuModule};
 use glam::{Vec2, Vec3};
 
 /// Output slices of [`Camera::generate`]; all have the batch's length.
@@ -25,6 +25,11 @@ pub trait Camera: Send + Sync {
     /// sample `lens[i]` in [0,1)².
     fn generate(&self, film: &[Vec2], lens: &[Vec2], out: CameraRays<'_>);
 
+    /// The camera's GPU side (see [`crate::gpu`]), `None` where the type has
+    /// none.
+    fn gpu(&self) -> Option<GpuModule> {
+        None
+    }
     /// Effects this camera needs (e.g. depth of field).
     fn effects(&self) -> Effects {
         Effects::empty()

@@ -10,6 +10,8 @@
 //!   module parses for itself with serde;
 //! * the [`Effects`] a module declares, from which the engine decides which
 //!   light-transport features a scene needs;
+//! * the optional GPU side of a module ([`GpuModule`]): WGSL with a fixed
+//!   signature per kind and parameters packed as words;
 //! * the small shared maths every module uses: [`Frame`], sampling warps in
 //!   [`warp`], stateless hashing in [`hash`], piecewise-constant
 //!   distributions in [`distribution`].
@@ -26,6 +28,7 @@ pub mod effects;
 pub mod exr_file;
 pub mod filter;
 pub mod frame;
+pub mod gpu;
 pub mod hash;
 pub mod input_file;
 pub mod light;
@@ -42,6 +45,7 @@ pub use color::{Rgb, luminance};
 pub use effects::Effects;
 pub use filter::{Filter, FilterSampler};
 pub use frame::Frame;
+pub use gpu::{GpuLibrary, GpuModule, GpuParams};
 pub use light::{EmitterEval, EmitterHit, Light, LightSample};
 pub use params::{Color, Numbers, ParamError, Params, TextureInput};
 pub use registry::{ModuleInfo, ModuleKind, ParamDoc, Registry};

@@ -14,7 +14,7 @@
 //! ([`BuildContext::scene_sphere`](crate::BuildContext::scene_sphere)):
 //! `p = reference + direction · 2r`, with `n = 0`.
 
-use crate::{Effects, Rgb};
+use crate::{Effects, GpuModule, Rgb};
 use glam::{Vec2, Vec3};
 
 /// One light sample as seen from a reference point.
@@ -83,6 +83,11 @@ pub trait Light: Send + Sync {
         out[..dirs.len()].fill(EmitterEval::default());
     }
 
+    /// The light's GPU side (see [`crate::gpu`]), `None` where the type has
+    /// none.
+    fn gpu(&self) -> Option<GpuModule> {
+        None
+    }
     /// Effects this light needs.
     fn effects(&self) -> Effects;
 }

@@ -21,4 +21,9 @@ pub trait Sampler: Send + Sync {
 
     /// Writes dimension `dim` of sample `ids[i]` into `out[i]`, in [0, 1).
     fn fill_1d(&self, ids: &[SampleId], dim: u32, out: &mut [f32]);
+    /// The sampler's GPU side (see [`crate::gpu`]), `None` where the type
+    /// has none.
+    fn gpu(&self) -> Option<crate::GpuModule> {
+        None
+    }
 }

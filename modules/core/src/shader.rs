@@ -5,7 +5,7 @@
 //! where it comes from. Values include the cosine foreshortening factor
 //! |cos θi|, so a path's throughput is multiplied by `weight` directly.
 
-use crate::{Effects, Frame, Rgb, TextureId, TextureTable};
+use crate::{Effects, Frame, GpuModule, Rgb, TextureId, TextureTable};
 use glam::{Vec2, Vec3};
 
 /// The surface points of one shading batch.
@@ -227,6 +227,11 @@ pub trait Shader: Send + Sync {
         out: &mut [BsdfEval],
     );
 
+    /// The shader's GPU side (see [`crate::gpu`]), `None` where the type has
+    /// none (the GPU backend then refuses the scene, naming it).
+    fn gpu(&self) -> Option<GpuModule> {
+        None
+    }
     /// Effects this shader needs (its lobes, its textures).
     fn effects(&self) -> Effects;
 }

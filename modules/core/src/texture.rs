@@ -21,6 +21,11 @@ pub trait Texture: Send + Sync {
     /// The mean value over the unit square, used for power estimates.
     fn mean(&self) -> Rgb;
 
+    /// The texture's GPU side (see [`crate::gpu`]), `None` where the type has
+    /// none.
+    fn gpu(&self) -> Option<crate::GpuModule> {
+        None
+    }
     /// Effects this texture needs.
     fn effects(&self) -> Effects {
         Effects::TEXTURES

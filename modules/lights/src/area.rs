@@ -14,8 +14,8 @@ use crate::sphere::Cone;
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::warp::{square_to_uniform_sphere, square_to_uniform_triangle};
 use radiant_core::{
-    Color, Effects, EmitterEval, EmitterHit, EmitterShape, Light, LightSample, ModuleInfo,
-    ParamDoc, ParamError, Params, Registry, Rgb, luminance,
+    Color, Effects, EmitterEval, EmitterHit, EmitterShape, GpuModule, GpuParams, Light,
+    LightSample, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb, luminance,
 };
 use serde::Deserialize;
 
@@ -263,6 +263,32 @@ impl Light for AreaLight {
 
     fn effects(&self) -> Effects {
         Effects::AREA_LIGHTS
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let mut params = GpuParams::new()
+            .rgb(self.radiance)
+            .u32(self.parts.len() as u32)
+            .u32(self.part_of.len() as u32);
+        for (i, part) in self.parts.iter().enumerate() {
+            let head = |kind: u32| {
+                GpuParams::new()
+                    .u32(kind)
+                    .f32(self.probability[i])
+                    .f32(self.cdf[i])
+            };
+            let record = match *part {
+                Part::Triangle([a, b, c], n) => head(0).vec3(a).vec3(b).vec3(c).vec3(n),
+                Part::Rectangle(r) => head(1).vec3(r.corner).vec3(r.ex).vec3(r.ey).vec3(r.n),
+                Part::Sphere(centre, radius) => head(2).vec3(centre).f32(radius).f32s([0.0; 6]),
+            };
+            debug_assert_eq!(record.len(), 15);
+            params = params.append(&record).f32(0.0);
+        }
+        for &part in &self.part_of {
+            params = params.u32(part);
+        }
+        Some(GpuModule::new("area", include_str!("area.wgsl"), params))
     }
 }
 

@@ -4,8 +4,8 @@ use crate::delta::sample_delta;
 use crate::params::{check_colour, place};
 use radiant_core::glam::{DVec3, Vec2, Vec3};
 use radiant_core::{
-    BuildContext, Color, Effects, Light, LightSample, Numbers, ParamDoc, ParamError, Params,
-    Registry, Rgb, luminance,
+    BuildContext, Color, Effects, GpuModule, GpuParams, Light, LightSample, Numbers, ParamDoc,
+    ParamError, Params, Registry, Rgb, luminance,
 };
 use serde::Deserialize;
 
@@ -71,6 +71,11 @@ impl Light for PointLight {
 
     fn effects(&self) -> Effects {
         Effects::DELTA_LIGHTS
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let params = GpuParams::new().vec3(self.position).rgb(self.intensity);
+        Some(GpuModule::new("point", include_str!("point.wgsl"), params))
     }
 }
 

@@ -5,7 +5,7 @@ use crate::pointwise::{Pointwise, pointwise_sampler};
 use crate::seed::fold;
 use radiant_core::glam::Vec2;
 use radiant_core::hash::{hash4_first, hash4_last, hash4_middle, unit_float};
-use radiant_core::{Registry, SampleId};
+use radiant_core::{GpuModule, GpuParams, Registry, SampleId};
 
 /// Independent uniform random numbers: dimension `dim` of sample `id` is
 /// `hash4(seed, id.pixel, id.index, dim)`, computed in stages so that the
@@ -44,6 +44,14 @@ impl Pointwise for Independent {
             unit_float(hash4_last(state, dim)),
             unit_float(hash4_last(state, dim + 1)),
         )
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        Some(GpuModule::new(
+            "independent",
+            include_str!("independent.wgsl"),
+            GpuParams::new().u32(self.seed_state),
+        ))
     }
 }
 

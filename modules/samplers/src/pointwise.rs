@@ -21,6 +21,11 @@ pub(crate) trait Pointwise {
     fn value_2d(&self, id: SampleId, dim: u32) -> Vec2 {
         Vec2::new(self.value_1d(id, dim), self.value_1d(id, dim + 1))
     }
+
+    /// The sampler's GPU side: `sample_1d_T` computing [`value_1d`](Self::value_1d).
+    fn gpu(&self) -> Option<radiant_core::GpuModule> {
+        None
+    }
 }
 
 /// Writes `value(ids[i])` into `out[i]`: with AVX2 where the CPU has it
@@ -70,6 +75,10 @@ macro_rules! pointwise_sampler {
                 $crate::pointwise::fill(ids, out, |id| {
                     $crate::pointwise::Pointwise::value_1d(self, id, dim)
                 });
+            }
+
+            fn gpu(&self) -> Option<radiant_core::GpuModule> {
+                $crate::pointwise::Pointwise::gpu(self)
             }
         }
     };

@@ -5,6 +5,7 @@
 //! colour. Mitsuba 3's `conductor` and `roughconductor` in one module.
 
 use crate::fresnel;
+use crate::gpu;
 use crate::inputs::{
     ROUGHNESS_DOCS, Roughness, anisotropy, fraction, one, roughness, scalar, texture_effects,
 };
@@ -14,8 +15,8 @@ use crate::microfacet::{Ggx, reflect};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, Color, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
-    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, Color, Effects, GpuModule, GpuParams, ParamDoc, ParamError, Params,
+    Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 
@@ -157,6 +158,25 @@ impl Shader for Conductor {
 
     fn effects(&self) -> Effects {
         self.effects
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let (kind, eta, k) = match self.fresnel {
+            Reflectance::Mirror => (0, Rgb::ZERO, Rgb::ZERO),
+            Reflectance::Complex { eta, k } => (1, eta, k),
+        };
+        let params = GpuParams::new()
+            .u32(kind)
+            .rgb(eta)
+            .rgb(k)
+            .texture(self.specular)
+            .u32(u32::from(self.rough.smooth))
+            .texture(self.rough.u)
+            .texture(self.rough.v);
+        Some(
+            GpuModule::new("conductor", include_str!("conductor.wgsl"), params)
+                .with_libraries(&[gpu::MICROFACET, gpu::FRESNEL]),
+        )
     }
 }
 

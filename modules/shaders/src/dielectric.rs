@@ -6,6 +6,7 @@
 //! radiance is scaled by (η_i/η_t)².
 
 use crate::fresnel;
+use crate::gpu;
 use crate::inputs::{
     BK7, Ior, ROUGHNESS_DOCS, Roughness, anisotropy, fraction, one, relative_ior, roughness,
     scalar, texture_effects,
@@ -15,8 +16,8 @@ use crate::microfacet::Ggx;
 use radiant_core::glam::Vec3;
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry,
-    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, GpuModule, GpuParams, ParamDoc, ParamError,
+    Params, Registry, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 
@@ -166,6 +167,18 @@ impl Shader for Dielectric {
 
     fn effects(&self) -> Effects {
         self.effects
+    }
+
+    /// Smooth dielectrics only, so far: a rough one has no GPU side.
+    fn gpu(&self) -> Option<GpuModule> {
+        self.rough.smooth.then(|| {
+            let params = GpuParams::new()
+                .f32(self.eta)
+                .texture(self.reflectance)
+                .texture(self.transmittance);
+            GpuModule::new("dielectric", include_str!("dielectric.wgsl"), params)
+                .with_libraries(&[gpu::FRESNEL])
+        })
     }
 }
 

@@ -23,6 +23,7 @@ mod conductor;
 mod dielectric;
 mod diffuse;
 mod fresnel;
+mod gpu;
 mod half_vector;
 mod inputs;
 mod lobes;

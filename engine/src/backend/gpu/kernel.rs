@@ -1,0 +1,342 @@
+//! Kernel assembly: a frame's WGSL, made of exactly the module types it
+//! uses and the integrator paths its effects need.
+//!
+//! Plain generation, no composition crate: module code is a set of flat
+//! functions with fixed names per kind, so assembly is concatenation —
+//! the prelude, each library once, each used type once — plus generated
+//! dispatchers (a `switch` on the type tag where a kind has several types,
+//! a direct call where it has one), and the integrator's and geometry's
+//! sources with the blocks between `//#if FEATURE` and `//#endif` kept
+//! only where the frame has the feature. What a scene does not use is
+//! not in its source, so a reader of the dumped WGSL (`--dump-wgsl`) sees
+//! what runs, and a compile error's line falls in a named part
+//! ([`Kernel::part_at`]). Numeric switches (depth, roulette) are
+//! pipeline-overridable constants, set when the pipeline is made.
+
+use super::modules::{KindTypes, Modules};
+use super::upload::Geometry;
+use crate::extract::RenderScene;
+use radiant_core::{Effects, GpuLibrary};
+use std::fmt::Write;
+
+const GEOMETRY: &str = include_str!("wgsl/geometry.wgsl");
+const PATH: &str = include_str!("wgsl/path.wgsl");
+
+/// Features that select blocks of the kernel's own sources.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Features {
+    /// Instances through a top level.
+    pub instances: bool,
+    /// Sphere primitives.
+    pub spheres: bool,
+    /// Textures that vary (interpolated texture coordinates).
+    pub textures: bool,
+    /// Any light (next-event estimation).
+    pub lights: bool,
+    /// Surfaces that emit.
+    pub area_lights: bool,
+    /// Lights at infinity that escaped rays see.
+    pub environment: bool,
+}
+
+impl Features {
+    /// The features of a frame.
+    pub fn of(scene: &RenderScene, geometry: &Geometry, modules: &Modules) -> Self {
+        Self {
+            instances: geometry.instanced,
+            spheres: geometry.spheres,
+            textures: scene.effects.contains(Effects::TEXTURES),
+            lights: !scene.lights.is_empty(),
+            area_lights: modules.area_lights,
+            environment: false,
+        }
+    }
+
+    fn enabled(&self, name: &str) -> Option<bool> {
+        Some(match name {
+            "INSTANCES" => self.instances,
+            "SPHERES" => self.spheres,
+            "TEXTURES" => self.textures,
+            "LIGHTS" => self.lights,
+            "AREA_LIGHTS" => self.area_lights,
+            "ENVIRONMENT" => self.environment,
+            _ => return None,
+        })
+    }
+
+    /// The names of the features that are on.
+    pub fn names(&self) -> Vec<&'static str> {
+        [
+            ("instances", self.instances),
+            ("spheres", self.spheres),
+            ("textures", self.textures),
+            ("next-event estimation", self.lights),
+            ("area lights", self.area_lights),
+            ("environment", self.environment),
+        ]
+        .into_iter()
+        .filter_map(|(n, on)| on.then_some(n))
+        .collect()
+    }
+}
+
+/// Keeps the lines of `source` outside disabled `//#if` blocks (`//#else`
+/// flips a block; blocks nest).
+fn preprocess(source: &str, features: &Features) -> String {
+    let mut out = String::with_capacity(source.len());
+    // Per open block: whether its current branch is kept.
+    let mut stack: Vec<bool> = Vec::new();
+    for line in source.lines() {
+        let t = line.trim();
+        if let Some(name) = t.strip_prefix("//#if ") {
+            let on = features.enabled(name.trim()).unwrap_or(false);
+            stack.push(on);
+        } else if t == "//#else" {
+            if let Some(top) = stack.last_mut() {
+                *top = !*top;
+            }
+        } else if t == "//#endif" {
+            stack.pop();
+        } else if stack.iter().all(|&on| on) {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    out
+}
+
+/// An assembled kernel: its source and the part each line range came from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Kernel {
+    /// The WGSL.
+    pub source: String,
+    /// (first line, part name) in source order: lines from `first` on
+    /// belong to that part until the next entry.
+    parts: Vec<(usize, String)>,
+    /// The features compiled in.
+    pub features: Features,
+}
+
+impl Kernel {
+    /// Assembles the kernel for `modules` and `features`.
+    pub fn assemble(modules: &Modules, features: Features) -> Self {
+        let mut k = Kernel {
+            source: String::new(),
+            parts: Vec::new(),
+            features,
+        };
+        k.part(
+            "the module prelude (radiant-core)",
+            radiant_core::gpu::PRELUDE,
+        );
+        let mut libraries: Vec<GpuLibrary> = Vec::new();
+        let kinds = [
+            ("camera", &modules.camera),
+            ("sampler", &modules.sampler),
+            ("shader", &modules.shaders),
+            ("texture", &modules.textures),
+            ("light", &modules.lights),
+        ];
+        for (_, types) in kinds {
+            for t in &types.types {
+                for lib in t.requires {
+                    add_library(&mut libraries, lib);
+                }
+            }
+        }
+        for lib in &libraries {
+            k.part(&format!("the library `{}`", lib.name), lib.wgsl);
+        }
+        for (kind, types) in kinds {
+            for t in &types.types {
+                k.part(&format!("the {kind} module `{}`", t.ident), &t.wgsl);
+            }
+        }
+        k.part("the generated dispatchers", &dispatchers(modules));
+        k.part(
+            "the GPU backend's geometry (wgsl/geometry.wgsl)",
+            &preprocess(GEOMETRY, &features),
+        );
+        k.part(
+            "the GPU backend's path integrator (wgsl/path.wgsl)",
+            &preprocess(PATH, &features),
+        );
+        k
+    }
+
+    fn part(&mut self, name: &str, source: &str) {
+        let line = self.source.lines().count();
+        self.parts.push((line, name.to_string()));
+        writeln!(self.source, "// ---- {name} ----").expect("writing to a String");
+        self.source.push_str(source);
+        if !source.ends_with('\n') {
+            self.source.push('\n');
+        }
+    }
+
+    /// The part of the kernel that line `line` (0-based) lies in.
+    pub fn part_at(&self, line: usize) -> Option<&str> {
+        self.parts
+            .iter()
+            .rev()
+            .find(|(first, _)| *first <= line)
+            .map(|(_, name)| name.as_str())
+    }
+}
+
+/// Adds `lib` after the libraries it requires, each once.
+fn add_library(libraries: &mut Vec<GpuLibrary>, lib: &GpuLibrary) {
+    if libraries.iter().any(|l| l.name == lib.name) {
+        return;
+    }
+    for dep in lib.requires {
+        add_library(libraries, dep);
+    }
+    libraries.push(*lib);
+}
+
+/// The (tag, identifier) of each type of a kind.
+fn tagged(types: &KindTypes) -> Vec<(u32, &str)> {
+    types
+        .types
+        .iter()
+        .enumerate()
+        .map(|(i, t)| (i as u32, t.ident.as_str()))
+        .collect()
+}
+
+/// A function `name(args)` that calls `prefix_T(offset, args)` for the
+/// instance's type `T`: directly where the kind has one type, else by a
+/// `switch` on the tag. `entry` is the WGSL expression of the instance's
+/// (tag, offset) pair.
+fn dispatcher(
+    out: &mut String,
+    signature: &str,
+    entry: &str,
+    prefix: &str,
+    args: &str,
+    types: &[(u32, &str)],
+) {
+    let call = |t: &str| format!("return {prefix}_{t}(e.y{args});");
+    let mut body = format!("fn {signature} {{\n    let e = {entry};\n");
+    match types {
+        [] => {}
+        [(_, only)] => body += &format!("    {}\n", call(only)),
+        [rest @ .., (_, last)] => {
+            body += "    switch e.x {\n";
+            for (tag, t) in rest {
+                body += &format!("        case {tag}u: {{ {} }}\n", call(t));
+            }
+            body += &format!("        default: {{ {} }}\n    }}\n", call(last));
+        }
+    }
+    out.push_str(&body);
+    out.push_str("}\n\n");
+}
+
+/// The generated entry points the integrator calls.
+fn dispatchers(m: &Modules) -> String {
+    let mut s = String::new();
+    let cam = &m.camera.types[0].ident;
+    let smp = &m.sampler.types[0].ident;
+    let _ = writeln!(
+        s,
+        "fn camera_ray(film: vec2f, lens: vec2f) -> CameraRay {{\n    return camera_ray_{cam}(param_u32(H_CAMERA), film, lens);\n}}\n"
+    );
+    let _ = writeln!(
+        s,
+        "fn sample_1d(pixel: u32, index: u32, dim: u32) -> f32 {{\n    return sample_1d_{smp}(param_u32(H_SAMPLER), pixel, index, dim);\n}}\n"
+    );
+    let material = "vec2u(param_u32(param_u32(H_MATERIALS) + 4u * m), param_u32(param_u32(H_MATERIALS) + 4u * m + 1u))";
+    dispatcher(
+        &mut s,
+        "bsdf_sample(m: u32, s: ShadingPoint, u: vec3f) -> BsdfSample",
+        material,
+        "bsdf_sample",
+        ", s, u",
+        &tagged(&m.shaders),
+    );
+    dispatcher(
+        &mut s,
+        "bsdf_eval(m: u32, s: ShadingPoint, wi: vec3f) -> BsdfEval",
+        material,
+        "bsdf_eval",
+        ", s, wi",
+        &tagged(&m.shaders),
+    );
+    let _ = writeln!(
+        s,
+        "fn material_has_smooth_lobes(m: u32) -> bool {{\n    return param_u32(param_u32(H_MATERIALS) + 4u * m + 2u) != 0u;\n}}\n"
+    );
+    let texture = "vec2u(param_u32(param_u32(H_TEXTURES) + 4u * id), param_u32(param_u32(H_TEXTURES) + 4u * id + 1u))";
+    dispatcher(
+        &mut s,
+        "texture_eval(id: u32, uv: vec2f) -> vec3f",
+        texture,
+        "texture",
+        ", uv",
+        &tagged(&m.textures),
+    );
+    if m.textures.types.is_empty() {
+        let _ = writeln!(
+            s,
+            "fn texture_eval(id: u32, uv: vec2f) -> vec3f {{\n    return vec3f(0.0);\n}}\n"
+        );
+    }
+    if !m.lights.types.is_empty() {
+        let light = "vec2u(param_u32(param_u32(H_LIGHTS) + 4u * l), param_u32(param_u32(H_LIGHTS) + 4u * l + 1u))";
+        dispatcher(
+            &mut s,
+            "light_sample(l: u32, r: vec3f, u: vec2f) -> LightSample",
+            light,
+            "light_sample",
+            ", r, u",
+            &tagged(&m.lights),
+        );
+        if m.area_lights {
+            // Only surface lights are ever hit: dispatch among those types.
+            let hit_types: Vec<(u32, &str)> = tagged(&m.lights)
+                .into_iter()
+                .filter(|(tag, t)| {
+                    m.lights.types[*tag as usize]
+                        .wgsl
+                        .contains(&format!("fn light_hit_{t}("))
+                })
+                .collect();
+            let mut hit = String::new();
+            dispatcher(
+                &mut hit,
+                "light_hit(l: u32, h: EmitterHit) -> EmitterEval",
+                light,
+                "light_hit",
+                ", h",
+                &hit_types,
+            );
+            s.push_str(&hit);
+        }
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn disabled_blocks_are_left_out_and_else_branches_flip() {
+        let src = "a\n//#if SPHERES\nb\n//#else\nc\n//#endif\n//#if TEXTURES\n//#if SPHERES\nd\n//#endif\ne\n//#endif\nf\n";
+        let none = preprocess(src, &Features::default());
+        assert_eq!(none, "a\nc\nf\n");
+        let spheres = Features {
+            spheres: true,
+            ..Features::default()
+        };
+        assert_eq!(preprocess(src, &spheres), "a\nb\nf\n");
+        let both = Features {
+            spheres: true,
+            textures: true,
+            ..Features::default()
+        };
+        assert_eq!(preprocess(src, &both), "a\nb\nd\ne\nf\n");
+    }
+}

@@ -1,0 +1,446 @@
+//! The GPU backend: the frame's path tracer as a wgpu compute kernel.
+//!
+//! Per frame, [`GpuBackend::render`] gathers the modules' GPU sides
+//! ([`modules`]), lays out the geometry ([`upload`], [`bvh`]), assembles
+//! the kernel from exactly what the frame uses ([`kernel`]), compiles it
+//! (or reuses the pipeline of an identical kernel: animation frames
+//! recompile nothing), uploads into buffers kept between frames, and
+//! renders the samples in dispatches small enough for OS watchdogs. One
+//! invocation renders one pixel's samples (a megakernel; see the README's
+//! GPU section for why), so accumulation needs no atomics and a render is
+//! deterministic for a given seed and adapter.
+
+mod bvh;
+mod device;
+pub mod error;
+pub mod kernel;
+pub mod modules;
+pub mod upload;
+
+pub use device::GpuOptions;
+pub use error::GpuError;
+
+use super::{Progress, Rendered};
+use crate::extract::RenderScene;
+use crate::film::Image;
+use crate::integrators::path::UNLIMITED_DEPTH_CAP;
+use glam::Vec3;
+use kernel::{Features, Kernel};
+use modules::Modules;
+use std::time::Instant;
+use upload::Geometry;
+use wgpu::util::DeviceExt;
+
+/// Paths (pixels × samples) one dispatch renders at most, so that each
+/// stays far below OS watchdog limits (a few seconds) on a slow adapter.
+const PATHS_PER_DISPATCH: u64 = 1 << 21;
+
+/// Paths of the dispatches submitted together (between two reads of the
+/// counters, which must not overflow 32 bits: about 10 rays per path).
+const PATHS_PER_SUBMIT: u64 = 1 << 24;
+
+/// Film layers at most: a dispatch renders up to this many samples of
+/// each pixel, one invocation each, into separate layers (small frames
+/// then still fill the GPU).
+const MAX_LAYERS: u32 = 16;
+
+/// Bytes between the dispatches' uniforms (the dynamic-offset alignment
+/// every adapter accepts).
+const UNIFORM_STRIDE: u64 = 256;
+
+/// One dispatch: samples [first, first + samples) of rows [y0, y0 + rows).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Dispatch {
+    first: u32,
+    samples: u32,
+    y0: u32,
+    rows: u32,
+}
+
+/// The frame's dispatches, in order, for `layers` film layers.
+fn dispatches(width: u32, height: u32, spp: u32, layers: u32) -> Vec<Dispatch> {
+    let rows = (PATHS_PER_DISPATCH / (width as u64 * layers as u64)).clamp(1, height as u64) as u32;
+    let mut out = Vec::new();
+    let mut first = 0;
+    while first < spp {
+        let samples = layers.min(spp - first);
+        let mut y0 = 0;
+        while y0 < height {
+            out.push(Dispatch {
+                first,
+                samples,
+                y0,
+                rows: rows.min(height - y0),
+            });
+            y0 += rows;
+        }
+        first += samples;
+    }
+    out
+}
+
+/// Rows of the workgroup grid (8 × 8 pixels per workgroup).
+const WORKGROUP: u32 = 8;
+
+/// What a frame compiles to, before any GPU work: for `radiant info` and
+/// `--dump-wgsl`.
+pub struct Plan {
+    /// The modules' parameters and types.
+    pub modules: Modules,
+    /// The geometry.
+    pub geometry: Geometry,
+    /// The kernel.
+    pub kernel: Kernel,
+}
+
+impl Plan {
+    /// Plans `scene` for the GPU: fails, naming it, on a module without
+    /// GPU code or a feature the backend lacks.
+    pub fn new(scene: &RenderScene) -> Result<Self, GpuError> {
+        let modules = Modules::new(scene)?;
+        let geometry = Geometry::new(scene)?;
+        let features = Features::of(scene, &geometry, &modules);
+        let kernel = Kernel::assemble(&modules, features);
+        Ok(Self {
+            modules,
+            geometry,
+            kernel,
+        })
+    }
+}
+
+/// A compiled kernel, kept while frames assemble the same source.
+struct Pipeline {
+    source: String,
+    overrides: (u32, u32),
+    pipeline: wgpu::ComputePipeline,
+}
+
+/// The kernel's bindings (`wgsl/path.wgsl`): the dispatch's uniform, five
+/// read-only storage buffers, the film and the counters.
+fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    let read = wgpu::BufferBindingType::Storage { read_only: true };
+    let write = wgpu::BufferBindingType::Storage { read_only: false };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("frame"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: wgpu::BufferSize::new(32),
+                },
+                count: None,
+            },
+            entry(1, read),
+            entry(2, read),
+            entry(3, read),
+            entry(4, read),
+            entry(5, read),
+            entry(6, write),
+            entry(7, write),
+        ],
+    })
+}
+
+/// The GPU backend: a device and what it keeps between frames.
+pub struct GpuBackend {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    info: wgpu::AdapterInfo,
+    limits: wgpu::Limits,
+    pipeline: Option<Pipeline>,
+    layout: wgpu::BindGroupLayout,
+    errors: device::ErrorSink,
+}
+
+/// Uploads `data` (at least 16 bytes, so that empty arrays bind).
+fn storage(device: &wgpu::Device, label: &str, data: &[u8], writable: bool) -> wgpu::Buffer {
+    let mut usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+    if writable {
+        usage |= wgpu::BufferUsages::COPY_SRC;
+    }
+    let padded;
+    let contents = if data.len() < 16 {
+        padded = [data, &[0u8; 16][data.len()..]].concat();
+        &padded[..]
+    } else {
+        data
+    };
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage,
+    })
+}
+
+impl GpuBackend {
+    /// Opens an adapter as `options` say.
+    pub fn new(options: &GpuOptions) -> Result<Self, GpuError> {
+        let (device, queue, info, limits, errors) = device::open(options)?;
+        let layout = bind_group_layout(&device);
+        Ok(Self {
+            layout,
+            device,
+            queue,
+            info,
+            limits,
+            pipeline: None,
+            errors,
+        })
+    }
+
+    /// The adapter's description, as `auto` reports it.
+    pub fn adapter(&self) -> String {
+        format!(
+            "{} ({:?}, {:?})",
+            self.info.name, self.info.backend, self.info.device_type
+        )
+    }
+
+    /// Whether the adapter is a software rasteriser on the CPU (lavapipe).
+    pub fn is_software(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// The pipeline for `kernel` with the frame's overrides, compiled
+    /// unless the last frame's is the same.
+    fn pipeline(&mut self, kernel: &Kernel, overrides: (u32, u32)) -> Result<(), GpuError> {
+        if let Some(p) = &self.pipeline
+            && p.source == kernel.source
+            && p.overrides == overrides
+        {
+            return Ok(());
+        }
+        device::validate(kernel)?;
+        let module = self
+            .device
+            .create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("radiant path kernel"),
+                source: wgpu::ShaderSource::Wgsl(kernel.source.as_str().into()),
+            });
+        let constants = [
+            ("MAX_DEPTH", overrides.0 as f64),
+            ("RR_DEPTH", overrides.1 as f64),
+        ];
+        let pipeline = self
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("radiant path kernel"),
+                layout: Some(&self.device.create_pipeline_layout(
+                    &wgpu::PipelineLayoutDescriptor {
+                        label: Some("radiant path kernel"),
+                        bind_group_layouts: &[Some(&self.layout)],
+                        immediate_size: 0,
+                    },
+                )),
+                module: &module,
+                entry_point: Some("render"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
+                cache: None,
+            });
+        self.errors.check()?;
+        self.pipeline = Some(Pipeline {
+            source: kernel.source.clone(),
+            overrides,
+            pipeline,
+        });
+        Ok(())
+    }
+
+    /// Fails where a buffer of `bytes` exceeds the adapter's limits.
+    fn fits(&self, what: &'static str, bytes: usize) -> Result<(), GpuError> {
+        let allowed = self
+            .limits
+            .max_storage_buffer_binding_size
+            .min(self.limits.max_buffer_size);
+        if bytes as u64 > allowed {
+            return Err(GpuError::TooLarge {
+                what,
+                needed: bytes as u64,
+                allowed,
+            });
+        }
+        Ok(())
+    }
+
+    /// Renders `scene` (all its samples) and develops the image.
+    pub fn render(
+        &mut self,
+        scene: &RenderScene,
+        progress: &Progress<'_>,
+    ) -> Result<Rendered, GpuError> {
+        let plan = Plan::new(scene)?;
+        let s = &scene.settings;
+        let max_depth = if s.max_depth < 0 {
+            UNLIMITED_DEPTH_CAP
+        } else {
+            s.max_depth as u32
+        };
+        self.pipeline(&plan.kernel, (max_depth, s.rr_depth))?;
+        let (w, h) = (s.width, s.height);
+        let pixels = w as usize * h as usize;
+        let layers = ((1u64 << 20) / pixels as u64).clamp(1, MAX_LAYERS.min(s.spp) as u64) as u32;
+        let film_bytes = pixels * layers as usize * 16;
+        let g = &plan.geometry;
+        self.fits("the film", film_bytes)?;
+        self.fits("the BVH nodes", g.nodes.len() * 64)?;
+        self.fits("the primitives", g.prims.len() * 16)?;
+        self.fits("the shading data", g.shading.len() * 16)?;
+        self.fits("the module parameters", plan.modules.params.len() * 4)?;
+        let d = &self.device;
+        let params = storage(
+            d,
+            "params",
+            bytemuck::cast_slice(&plan.modules.params),
+            false,
+        );
+        let nodes = storage(d, "nodes", bytemuck::cast_slice(&g.nodes), false);
+        let prims = storage(d, "prims", bytemuck::cast_slice(&g.prims), false);
+        let shading = storage(d, "shading", bytemuck::cast_slice(&g.shading), false);
+        let instances = storage(d, "instances", bytemuck::cast_slice(&g.instances), false);
+        let film = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("film"),
+            size: film_bytes as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let counters = storage(d, "counters", &[0u8; 16], true);
+        let work = dispatches(w, h, s.spp, layers);
+        let mut slots = vec![0u32; work.len() * UNIFORM_STRIDE as usize / 4];
+        for (k, job) in work.iter().enumerate() {
+            let at = k * UNIFORM_STRIDE as usize / 4;
+            slots[at..at + 5].copy_from_slice(&[w, h, job.first, job.samples, job.y0]);
+        }
+        let uniform = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("dispatches"),
+            contents: bytemuck::cast_slice(&slots),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let pipeline = &self.pipeline.as_ref().expect("compiled above").pipeline;
+        let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("frame"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &uniform,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(32),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: nodes.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: prims.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: shading.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: instances.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: film.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: counters.as_entire_binding(),
+                },
+            ],
+        });
+        self.errors.check()?;
+        let total = pixels as u64 * s.spp as u64;
+        let start = Instant::now();
+        let mut done = 0u64;
+        let mut counts = [0u64; 2];
+        let mut k = 0;
+        while k < work.len() {
+            // A run of dispatches of at most PATHS_PER_SUBMIT paths.
+            let mut enc = d.create_command_encoder(&Default::default());
+            let mut paths = 0u64;
+            {
+                let mut pass = enc.begin_compute_pass(&Default::default());
+                pass.set_pipeline(pipeline);
+                while k < work.len() {
+                    let job = work[k];
+                    let n = w as u64 * job.rows as u64 * job.samples as u64;
+                    if paths > 0 && paths + n > PATHS_PER_SUBMIT {
+                        break;
+                    }
+                    pass.set_bind_group(0, &bind, &[(k as u64 * UNIFORM_STRIDE) as u32]);
+                    pass.dispatch_workgroups(
+                        w.div_ceil(WORKGROUP),
+                        job.rows.div_ceil(WORKGROUP),
+                        job.samples,
+                    );
+                    paths += n;
+                    k += 1;
+                }
+            }
+            self.queue.submit([enc.finish()]);
+            let c = device::read_u32s(d, &self.queue, &counters, 4, &self.errors)?;
+            counts[0] += u64::from(c[0]);
+            counts[1] += u64::from(c[1]);
+            self.queue.write_buffer(&counters, 0, &[0u8; 16]);
+            done += paths;
+            progress.report(done, total);
+        }
+        let sums = device::read_f32s(
+            d,
+            &self.queue,
+            &film,
+            pixels * layers as usize * 4,
+            &self.errors,
+        )?;
+        let time = start.elapsed();
+        let image = (0..pixels)
+            .map(|i| {
+                let (mut c, mut wsum) = (Vec3::ZERO, 0.0);
+                for layer in sums.chunks_exact(pixels * 4) {
+                    let p = &layer[4 * i..4 * i + 4];
+                    c += Vec3::new(p[0], p[1], p[2]);
+                    wsum += p[3];
+                }
+                if wsum != 0.0 { c / wsum } else { Vec3::ZERO }
+            })
+            .collect();
+        Ok(Rendered {
+            image: Image {
+                width: w,
+                height: h,
+                pixels: image,
+            },
+            time,
+            samples: total,
+            rays: counts[1],
+            invalid_samples: counts[0],
+        })
+    }
+}

@@ -1,0 +1,277 @@
+//! The frame's modules on the GPU: each instance's [`GpuModule`] gathered,
+//! its parameters placed in the one parameter buffer, and the tables the
+//! kernel looks instances up in (a header, then per kind a directory of
+//! (type, parameter offset, flags, value) entries), with the pixel
+//! filter tabulated for importance sampling.
+//!
+//! A module without GPU code makes the frame fail with an error that names
+//! it ([`GpuError::MissingCode`]).
+
+use super::error::GpuError;
+use crate::extract::RenderScene;
+use radiant_core::{Effects, Filter, GpuLibrary, GpuModule, TextureId, TextureRef};
+
+/// Cells per axis of the tabulated filter.
+const FILTER_RES: u32 = 64;
+
+/// Words of the header at the start of the parameter buffer (the `H_*`
+/// constants of `wgsl/path.wgsl`).
+const HEADER_WORDS: usize = 12;
+
+/// One module type of a kind, as the kernel includes it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModuleType {
+    /// Identifier in its functions' names.
+    pub ident: String,
+    /// Its WGSL.
+    pub wgsl: String,
+    /// Libraries it calls.
+    pub requires: &'static [GpuLibrary],
+}
+
+/// The module types of one kind in a frame, in order of first use (an
+/// instance's type tag is its index here).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct KindTypes {
+    /// The types.
+    pub types: Vec<ModuleType>,
+}
+
+impl KindTypes {
+    /// The tag of `module`'s type, adding the type where it is new.
+    fn tag(&mut self, module: &GpuModule) -> u32 {
+        match self.types.iter().position(|t| t.ident == module.ident) {
+            Some(i) => i as u32,
+            None => {
+                self.types.push(ModuleType {
+                    ident: module.ident.to_string(),
+                    wgsl: module.wgsl.to_string(),
+                    requires: module.requires,
+                });
+                self.types.len() as u32 - 1
+            }
+        }
+    }
+}
+
+/// The frame's modules in GPU form.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Modules {
+    /// The parameter buffer: header, directories, module parameters,
+    /// light CDF, filter table.
+    pub params: Vec<u32>,
+    /// The camera's type.
+    pub camera: KindTypes,
+    /// The sampler's type.
+    pub sampler: KindTypes,
+    /// The shader types.
+    pub shaders: KindTypes,
+    /// The light types.
+    pub lights: KindTypes,
+    /// The texture types (the built-in `constant` first where used).
+    pub textures: KindTypes,
+    /// Whether the lights include surface emitters that rays hit.
+    pub area_lights: bool,
+}
+
+/// The built-in texture type of constant values.
+const CONSTANT_TEXTURE: &str =
+    "fn texture_constant(p: u32, uv: vec2f) -> vec3f {\n    return param_vec3(p);\n}\n";
+
+impl Modules {
+    /// Gathers the modules of `scene`.
+    pub fn new(scene: &RenderScene) -> Result<Self, GpuError> {
+        let mut m = Modules {
+            params: vec![0; HEADER_WORDS],
+            ..Modules::default()
+        };
+        let modules = &scene.modules;
+        let type_of = |kind: radiant_core::ModuleKind| {
+            modules
+                .iter()
+                .filter(|(k, _)| *k == kind)
+                .map(|(_, t)| t.as_str())
+                .collect::<Vec<_>>()
+                .join(" or ")
+        };
+        // Camera and sampler: one instance each.
+        let camera = scene.camera.gpu().ok_or_else(|| GpuError::MissingCode {
+            kind: "camera",
+            name: "of the scene".into(),
+            type_name: type_of(radiant_core::ModuleKind::Camera),
+        })?;
+        m.camera.tag(&camera);
+        m.params[1] = m.push(&camera);
+        let sampler = scene.sampler.gpu().ok_or_else(|| GpuError::MissingCode {
+            kind: "sampler",
+            name: "of the scene".into(),
+            type_name: type_of(radiant_core::ModuleKind::Sampler),
+        })?;
+        m.sampler.tag(&sampler);
+        m.params[2] = m.push(&sampler);
+        m.filter_table(scene.filter.as_ref());
+        m.materials(scene)?;
+        m.textures(scene)?;
+        m.lights(scene)?;
+        Ok(m)
+    }
+
+    /// Appends `module`'s parameters; returns their offset.
+    fn push(&mut self, module: &GpuModule) -> u32 {
+        let at = self.params.len() as u32;
+        self.params.extend_from_slice(module.params.words());
+        at
+    }
+
+    /// The filter tabulated as [`FilterSampler`](radiant_core::FilterSampler)
+    /// tabulates it: the marginal CDF of the rows, each row's CDF, then the
+    /// sign of f per cell.
+    fn filter_table(&mut self, filter: &dyn Filter) {
+        let res = FILTER_RES as usize;
+        let radius = filter.radius();
+        let cell = 2.0 * radius / res as f32;
+        let values: Vec<f32> = (0..res * res)
+            .map(|i| {
+                let x = -radius + ((i % res) as f32 + 0.5) * cell;
+                let y = -radius + ((i / res) as f32 + 0.5) * cell;
+                filter.eval(x, y)
+            })
+            .collect();
+        let rows: Vec<f64> = values
+            .chunks(res)
+            .map(|r| r.iter().map(|v| v.abs() as f64).sum())
+            .collect();
+        let total: f64 = rows.iter().sum();
+        let mut table = Vec::with_capacity(res + 2 * res * res);
+        let cdf = |weights: &mut dyn Iterator<Item = f64>, sum: f64, out: &mut Vec<f32>| {
+            let mut acc = 0.0;
+            for (k, w) in weights.enumerate() {
+                acc += w;
+                out.push(if sum > 0.0 {
+                    (acc / sum) as f32
+                } else {
+                    (k + 1) as f32 / res as f32
+                });
+            }
+            if let Some(last) = out.last_mut() {
+                *last = 1.0;
+            }
+        };
+        cdf(&mut rows.iter().copied(), total, &mut table);
+        for (r, &sum) in values.chunks(res).zip(&rows) {
+            cdf(&mut r.iter().map(|v| v.abs() as f64), sum, &mut table);
+        }
+        table.extend(values.iter().map(|v| 1.0f32.copysign(*v)));
+        let integral = (total * (cell * cell) as f64) as f32;
+        self.params[3] = self.params.len() as u32;
+        self.params[4] = FILTER_RES;
+        self.params[5] = radius.to_bits();
+        self.params[6] = integral.to_bits();
+        self.params.extend(table.iter().map(|v| v.to_bits()));
+    }
+
+    /// The materials' directory: (type, offset, flags, 0) per material;
+    /// flag 1: the shader has smooth lobes (next-event estimation
+    /// evaluates it).
+    fn materials(&mut self, scene: &RenderScene) -> Result<(), GpuError> {
+        let mut entries = Vec::with_capacity(4 * scene.shaders.len());
+        for (i, shader) in scene.shaders.iter().enumerate() {
+            let module = shader.gpu().ok_or_else(|| GpuError::MissingCode {
+                kind: "material",
+                name: scene
+                    .material_names
+                    .get(i)
+                    .cloned()
+                    .unwrap_or_else(|| format!("#{i}")),
+                type_name: scene.material_types.get(i).cloned().unwrap_or_default(),
+            })?;
+            let tag = self.shaders.tag(&module);
+            let at = self.push(&module);
+            let smooth = u32::from(shader.effects().contains(Effects::SMOOTH_LOBES));
+            entries.extend([tag, at, smooth, 0]);
+        }
+        self.params[7] = self.params.len() as u32;
+        self.params.extend(entries);
+        Ok(())
+    }
+
+    /// The textures' directory: (type, offset, 0, 0) per texture.
+    fn textures(&mut self, scene: &RenderScene) -> Result<(), GpuError> {
+        let constant = GpuModule::new("constant", CONSTANT_TEXTURE, Default::default());
+        let mut entries = Vec::with_capacity(4 * scene.textures.len());
+        for i in 0..scene.textures.len() as u32 {
+            let module = match scene.textures.get(TextureId(i)) {
+                TextureRef::Constant(c) => GpuModule {
+                    params: radiant_core::GpuParams::new().rgb(c),
+                    ..constant.clone()
+                },
+                TextureRef::Module(t) => t.gpu().ok_or_else(|| GpuError::MissingCode {
+                    kind: "texture",
+                    name: format!("#{i}"),
+                    type_name: "(a texture module)".into(),
+                })?,
+            };
+            let tag = self.textures.tag(&module);
+            let at = self.push(&module);
+            entries.extend([tag, at, 0, 0]);
+        }
+        self.params[8] = self.params.len() as u32;
+        self.params.extend(entries);
+        Ok(())
+    }
+
+    /// The lights' directory: (type, offset, delta, probability) per
+    /// light, then the CDF of the probabilities.
+    fn lights(&mut self, scene: &RenderScene) -> Result<(), GpuError> {
+        let table = &scene.lights;
+        let mut entries = Vec::with_capacity(4 * table.len());
+        for (i, light) in table.lights().iter().enumerate() {
+            let module = light.gpu().ok_or_else(|| GpuError::MissingCode {
+                kind: "light",
+                name: format!("#{}", i + 1),
+                type_name: scene.light_types.get(i).cloned().unwrap_or_default(),
+            })?;
+            if light.effects().contains(Effects::ENVIRONMENT) {
+                return Err(GpuError::Unsupported("an environment light".into()));
+            }
+            self.area_lights |= light.effects().contains(Effects::AREA_LIGHTS);
+            let tag = self.lights.tag(&module);
+            let at = self.push(&module);
+            entries.extend([
+                tag,
+                at,
+                u32::from(table.is_delta(i)),
+                table.pmf(i).to_bits(),
+            ]);
+        }
+        self.params[9] = self.params.len() as u32;
+        self.params[10] = table.len() as u32;
+        self.params.extend(entries);
+        self.params[11] = self.params.len() as u32;
+        let mut acc = 0.0f64;
+        for i in 0..table.len() {
+            acc += table.pmf(i) as f64;
+            let c = if i + 1 == table.len() {
+                1.0
+            } else {
+                acc as f32
+            };
+            self.params.push(c.to_bits());
+        }
+        Ok(())
+    }
+
+    /// Every module type in use, by kind, for `radiant info`.
+    pub fn summary(&self) -> Vec<(&'static str, Vec<&str>)> {
+        fn names(k: &KindTypes) -> Vec<&str> {
+            k.types.iter().map(|t| t.ident.as_str()).collect()
+        }
+        vec![
+            ("camera", names(&self.camera)),
+            ("sampler", names(&self.sampler)),
+            ("shaders", names(&self.shaders)),
+            ("textures", names(&self.textures)),
+            ("lights", names(&self.lights)),
+        ]
+    }
+}

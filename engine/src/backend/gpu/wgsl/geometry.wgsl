@@ -1,0 +1,443 @@
+// Geometry on the GPU: binary BVH traversal (closest and any hit), the two
+// levels through instances, ray–primitive tests, and hit resolution into
+// the interaction the integrator shades (integrators/surface.rs).
+//
+// Nodes are 4 vec4f: both children's boxes, each with a reference (a node
+// index, or the first primitive slot of a leaf) and a primitive count
+// (0: inner). Primitives are 4 vec4f: v0 (kind in w: 0 triangle, 1
+// sphere), v1, v2 (sphere: centre and radius in v0), then (material,
+// emitter, emitter primitive, shading index) as bits.
+
+const STACK_SIZE: u32 = 48u;
+const NO_HIT: u32 = 0xffffffffu;
+const GAMMA3: f32 = 1.7881397e-7;
+const GAMMA5: f32 = 2.9802326e-7;
+const GAMMA7: f32 = 4.1723263e-7;
+
+struct Hit {
+    t: f32,
+    slot: u32,
+    inst: u32,
+    b1: f32,
+    b2: f32,
+}
+
+fn prim_kind(slot: u32) -> u32 {
+    return bitcast<u32>(prims[4u * slot].w);
+}
+
+fn prim_info(slot: u32) -> vec4u {
+    return bitcast<vec4u>(prims[4u * slot + 3u]);
+}
+
+// Möller–Trumbore; updates `best` where the triangle is closer.
+fn hit_triangle(slot: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>) -> bool {
+    let v0 = prims[4u * slot].xyz;
+    let e1 = prims[4u * slot + 1u].xyz - v0;
+    let e2 = prims[4u * slot + 2u].xyz - v0;
+    let pv = cross(d, e2);
+    let det = dot(e1, pv);
+    if det == 0.0 {
+        return false;
+    }
+    let inv = 1.0 / det;
+    let tv = o - v0;
+    let b1 = dot(tv, pv) * inv;
+    if b1 < 0.0 || b1 > 1.0 {
+        return false;
+    }
+    let qv = cross(tv, e1);
+    let b2 = dot(d, qv) * inv;
+    if b2 < 0.0 || b1 + b2 > 1.0 {
+        return false;
+    }
+    let t = dot(e2, qv) * inv;
+    if t > 0.0 && t < (*best).t {
+        (*best).t = t;
+        (*best).slot = slot;
+        (*best).b1 = b1;
+        (*best).b2 = b2;
+        return true;
+    }
+    return false;
+}
+
+// Haines et al.'s precise ray–sphere test (accel/sphere.rs).
+fn hit_sphere(slot: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>) -> bool {
+    let c = prims[4u * slot].xyz;
+    let r = prims[4u * slot + 1u].x;
+    let f = o - c;
+    let a = dot(d, d);
+    let b = -dot(f, d);
+    let l = f + d * (b / a);
+    let disc = r * r - dot(l, l);
+    if disc < 0.0 {
+        return false;
+    }
+    let cc = dot(f, f) - r * r;
+    let q = b + select(-1.0, 1.0, b >= 0.0) * sqrt(a * disc);
+    if q == 0.0 {
+        return false;
+    }
+    let t0 = cc / q;
+    let t1 = q / a;
+    let near = min(t0, t1);
+    let far = max(t0, t1);
+    var t = -1.0;
+    if near > 0.0 && near < (*best).t {
+        t = near;
+    } else if far > 0.0 && far < (*best).t {
+        t = far;
+    }
+    if t > 0.0 {
+        (*best).t = t;
+        (*best).slot = slot;
+        (*best).b1 = 0.0;
+        (*best).b2 = 0.0;
+        return true;
+    }
+    return false;
+}
+
+fn hit_primitive(slot: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>) -> bool {
+//#if SPHERES
+    if prim_kind(slot) == 1u {
+        return hit_sphere(slot, o, d, best);
+    }
+//#endif
+    return hit_triangle(slot, o, d, best);
+}
+
+// Entry distance of the ray into box [lo, hi], or FLOAT_MAX where it
+// misses it within tmax.
+fn box_entry(lo: vec3f, hi: vec3f, o: vec3f, inv_d: vec3f, tmax: f32) -> f32 {
+    let t0 = (lo - o) * inv_d;
+    let t1 = (hi - o) * inv_d;
+    let tn = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));
+    let tf = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), min(max(t0.z, t1.z), tmax));
+    // Robust traversal (Ize 2013): the far distance grown by 2γ3.
+    if tn <= tf * (1.0 + 2.0 * GAMMA3) {
+        return tn;
+    }
+    return FLOAT_MAX;
+}
+
+fn safe_inverse(d: vec3f) -> vec3f {
+    let tiny = 1e-30;
+    return 1.0 / select(d, select(vec3f(-tiny), vec3f(tiny), d >= vec3f(0.0)), abs(d) < vec3f(tiny));
+}
+
+// Traverses the bottom level at node `root`; with `any`, returns at the
+// first hit.
+fn trace_blas(root: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>, any: bool) -> bool {
+    let inv_d = safe_inverse(d);
+    var stack: array<u32, STACK_SIZE>;
+    var sp = 0u;
+    var node = root;
+    var found = false;
+    loop {
+        let a_lo = nodes[4u * node];
+        let a_hi = nodes[4u * node + 1u];
+        let b_lo = nodes[4u * node + 2u];
+        let b_hi = nodes[4u * node + 3u];
+        let ta = box_entry(a_lo.xyz, a_hi.xyz, o, inv_d, (*best).t);
+        let tb = box_entry(b_lo.xyz, b_hi.xyz, o, inv_d, (*best).t);
+        var next = NO_HIT;
+        var later = NO_HIT;
+        let a_count = bitcast<u32>(a_hi.w);
+        let b_count = bitcast<u32>(b_hi.w);
+        if ta < FLOAT_MAX {
+            let first = bitcast<u32>(a_lo.w);
+            if a_count > 0u {
+                for (var i = 0u; i < a_count; i++) {
+                    if hit_primitive(first + i, o, d, best) {
+                        found = true;
+                        if any {
+                            return true;
+                        }
+                    }
+                }
+            } else {
+                next = first;
+            }
+        }
+        if tb < FLOAT_MAX {
+            let first = bitcast<u32>(b_lo.w);
+            if b_count > 0u {
+                for (var i = 0u; i < b_count; i++) {
+                    if hit_primitive(first + i, o, d, best) {
+                        found = true;
+                        if any {
+                            return true;
+                        }
+                    }
+                }
+            } else if next == NO_HIT {
+                next = first;
+            } else if tb < ta {
+                later = next;
+                next = first;
+            } else {
+                later = first;
+            }
+        }
+        if later != NO_HIT && sp < STACK_SIZE {
+            stack[sp] = later;
+            sp++;
+        }
+        if next == NO_HIT {
+            if sp == 0u {
+                break;
+            }
+            sp--;
+            next = stack[sp];
+        }
+        node = next;
+    }
+    return found;
+}
+
+//#if INSTANCES
+// Instances are 10 vec4f: the rows of render → object, of the normal
+// matrix and of object → render, then (bottom-level root, material or
+// NO_MATERIAL, 0, 0) as bits.
+fn instance_row(inst: u32, row: u32) -> vec4f {
+    return instances[10u * inst + row];
+}
+
+fn instance_meta(inst: u32) -> vec4u {
+    return bitcast<vec4u>(instances[10u * inst + 9u]);
+}
+
+fn affine_point(inst: u32, first: u32, p: vec3f) -> vec3f {
+    let p4 = vec4f(p, 1.0);
+    return vec3f(dot(instance_row(inst, first), p4), dot(instance_row(inst, first + 1u), p4), dot(instance_row(inst, first + 2u), p4));
+}
+
+fn affine_vector(inst: u32, first: u32, v: vec3f) -> vec3f {
+    let v4 = vec4f(v, 0.0);
+    return vec3f(dot(instance_row(inst, first), v4), dot(instance_row(inst, first + 1u), v4), dot(instance_row(inst, first + 2u), v4));
+}
+
+fn affine_abs_vector(inst: u32, first: u32, v: vec3f) -> vec3f {
+    let v4 = vec4f(v, 0.0);
+    return vec3f(dot(abs(instance_row(inst, first)), v4), dot(abs(instance_row(inst, first + 1u)), v4), dot(abs(instance_row(inst, first + 2u)), v4));
+}
+
+fn trace_scene(o: vec3f, d: vec3f, best: ptr<function, Hit>, any: bool) -> bool {
+    let inv_d = safe_inverse(d);
+    var stack: array<u32, STACK_SIZE>;
+    var sp = 0u;
+    var node = param_u32(H_ROOT);
+    var found = false;
+    loop {
+        let a_lo = nodes[4u * node];
+        let a_hi = nodes[4u * node + 1u];
+        let b_lo = nodes[4u * node + 2u];
+        let b_hi = nodes[4u * node + 3u];
+        let ta = box_entry(a_lo.xyz, a_hi.xyz, o, inv_d, (*best).t);
+        let tb = box_entry(b_lo.xyz, b_hi.xyz, o, inv_d, (*best).t);
+        var next = NO_HIT;
+        var later = NO_HIT;
+        for (var side = 0u; side < 2u; side++) {
+            let lo = select(b_lo, a_lo, side == 0u);
+            let hi = select(b_hi, a_hi, side == 0u);
+            let t = select(tb, ta, side == 0u);
+            if t == FLOAT_MAX {
+                continue;
+            }
+            let first = bitcast<u32>(lo.w);
+            let count = bitcast<u32>(hi.w);
+            if count > 0u {
+                for (var i = 0u; i < count; i++) {
+                    let inst = first + i;
+                    // The ray in the instance's space (same t).
+                    let oo = affine_point(inst, 0u, o);
+                    let od = affine_vector(inst, 0u, d);
+                    if trace_blas(instance_meta(inst).x, oo, od, best, any) {
+                        (*best).inst = inst;
+                        found = true;
+                        if any {
+                            return true;
+                        }
+                    }
+                }
+            } else if next == NO_HIT {
+                next = first;
+            } else if t < ta {
+                later = next;
+                next = first;
+            } else {
+                later = first;
+            }
+        }
+        if later != NO_HIT && sp < STACK_SIZE {
+            stack[sp] = later;
+            sp++;
+        }
+        if next == NO_HIT {
+            if sp == 0u {
+                break;
+            }
+            sp--;
+            next = stack[sp];
+        }
+        node = next;
+    }
+    return found;
+}
+//#endif
+
+fn closest_hit(o: vec3f, d: vec3f) -> Hit {
+    var best = Hit(FLOAT_MAX, NO_HIT, 0u, 0.0, 0.0);
+//#if INSTANCES
+    trace_scene(o, d, &best, false);
+//#else
+    trace_blas(param_u32(H_ROOT), o, d, &best, false);
+//#endif
+    return best;
+}
+
+// Whether anything lies on the segment o + t·d, t in (0, tmax).
+fn occluded(o: vec3f, d: vec3f, tmax: f32) -> bool {
+    var best = Hit(tmax, NO_HIT, 0u, 0.0, 0.0);
+//#if INSTANCES
+    return trace_scene(o, d, &best, true);
+//#else
+    return trace_blas(param_u32(H_ROOT), o, d, &best, true);
+//#endif
+}
+
+// ---- Hits resolved into interactions ----
+
+struct Interaction {
+    p: vec3f,
+    err: vec3f,
+    ng: vec3f,
+    // Shading frame: s, t, n.
+    frame: mat3x3f,
+    uv: vec2f,
+    material: u32,
+    emitter: u32,
+    emitter_prim: u32,
+}
+
+fn shading_frame(n: vec3f) -> mat3x3f {
+    let sgn = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (sgn + n.z);
+    let b = n.x * n.y * a;
+    let s = vec3f(1.0 + sgn * n.x * n.x * a, sgn * b, -sgn * n.x);
+    let t = vec3f(b, sgn + n.y * n.y * a, -n.y);
+    return mat3x3f(s, t, n);
+}
+
+fn to_local(f: mat3x3f, v: vec3f) -> vec3f {
+    return vec3f(dot(v, f[0]), dot(v, f[1]), dot(v, f[2]));
+}
+
+fn to_world(f: mat3x3f, v: vec3f) -> vec3f {
+    return f[0] * v.x + f[1] * v.y + f[2] * v.z;
+}
+
+// Shading normal bent above the geometric tangent plane (surface.rs).
+fn above_tangent_plane(ns: vec3f, ng: vec3f) -> vec3f {
+    let c = dot(ns, ng);
+    if c >= 0.01 {
+        return ns;
+    }
+    return normalize(ns + ng * (0.01 - c));
+}
+
+// The interaction in the primitive's own space.
+fn local_interaction(hit: Hit, o: vec3f, d: vec3f) -> Interaction {
+    var it: Interaction;
+    let slot = hit.slot;
+    let info = prim_info(slot);
+    it.material = info.x;
+    it.emitter = info.y;
+    it.emitter_prim = info.z;
+    let sh = info.w;
+//#if SPHERES
+    if prim_kind(slot) == 1u {
+        let c = prims[4u * slot].xyz;
+        let r = prims[4u * slot + 1u].x;
+        let n = normalize(o + d * hit.t - c);
+        it.p = c + n * r;
+        it.err = (abs(it.p) + abs(c)) * GAMMA5;
+        it.ng = n;
+        it.frame = shading_frame(n);
+//#if TEXTURES
+        let local = vec3f(dot(shading[4u * sh].xyz, n), dot(shading[4u * sh + 1u].xyz, n), dot(shading[4u * sh + 2u].xyz, n));
+        it.uv = vec2f(fract(atan2(local.y, local.x) * INV_PI * 0.5 + 1.0), acos(clamp(local.z, -1.0, 1.0)) * INV_PI);
+//#endif
+        return it;
+    }
+//#endif
+    let v0 = prims[4u * slot].xyz;
+    let v1 = prims[4u * slot + 1u].xyz;
+    let v2 = prims[4u * slot + 2u].xyz;
+    let b = vec3f(1.0 - hit.b1 - hit.b2, hit.b1, hit.b2);
+    let w0 = v0 * b.x;
+    let w1 = v1 * b.y;
+    let w2 = v2 * b.z;
+    it.p = w0 + w1 + w2;
+    it.err = (abs(w0) + abs(w1) + abs(w2)) * GAMMA7;
+    let ng = normalize(cross(v1 - v0, v2 - v0));
+    it.ng = ng;
+    var ns = ng;
+    let n0 = shading[4u * sh];
+    let n1 = shading[4u * sh + 1u];
+    let n2 = shading[4u * sh + 2u];
+    if any(n0.xyz != vec3f(0.0)) {
+        let sum = n0.xyz * b.x + n1.xyz * b.y + n2.xyz * b.z;
+        let l = length(sum);
+        if l > 0.0 && is_finite_f32(1.0 / l) {
+            ns = above_tangent_plane(sum / l, ng);
+        } else {
+            ns = above_tangent_plane(ng, ng);
+        }
+    }
+    it.frame = shading_frame(ns);
+//#if TEXTURES
+    let uv3 = shading[4u * sh + 3u];
+    it.uv = vec2f(n0.w, n1.w) * b.x + vec2f(n2.w, uv3.x) * b.y + uv3.yz * b.z;
+//#endif
+    return it;
+}
+
+fn interaction(hit: Hit, o: vec3f, d: vec3f) -> Interaction {
+//#if INSTANCES
+    let inst = hit.inst;
+    let m = instance_meta(inst);
+    let oo = affine_point(inst, 0u, o);
+    let od = affine_vector(inst, 0u, d);
+    var it = local_interaction(hit, oo, od);
+    if m.y != NO_HIT {
+        it.material = m.y;
+    }
+    // Out to render space with the transform's rounding error (instance.rs).
+    let p = it.p;
+    it.p = affine_point(inst, 6u, p);
+    let translation = abs(vec3f(instance_row(inst, 6u).w, instance_row(inst, 7u).w, instance_row(inst, 8u).w));
+    it.err = affine_abs_vector(inst, 6u, it.err) * (GAMMA3 + 1.0)
+        + (affine_abs_vector(inst, 6u, abs(p)) + translation) * GAMMA3;
+    it.ng = normalize(affine_vector(inst, 3u, it.ng));
+    var ns = normalize(affine_vector(inst, 3u, it.frame[2]));
+    it.frame = shading_frame(above_tangent_plane(ns, it.ng));
+    return it;
+//#else
+    return local_interaction(hit, o, d);
+//#endif
+}
+
+// The origin of a ray leaving p (error bound err, normal n) towards w
+// (accel/offset.rs).
+fn offset_origin(p: vec3f, err: vec3f, n: vec3f, w: vec3f) -> vec3f {
+    let dist = dot(abs(n), err);
+    let side = select(dist, -dist, dot(w, n) < 0.0);
+    let offset = n * side;
+    let po = p + offset;
+    let step = max(abs(po) * 1.1920929e-7, vec3f(1.17549435e-38));
+    let up = select(po, po + step, offset > vec3f(0.0));
+    return select(up, up - step, offset < vec3f(0.0));
+}

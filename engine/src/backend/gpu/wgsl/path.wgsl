@@ -1,0 +1,272 @@
+// The `path` integrator as a megakernel: one invocation renders the
+// samples of one pixel, path by path, with the estimator and sampler
+// dimensions of integrators/path.rs (next-event estimation with MIS by the
+// power heuristic, lights chosen in proportion to power, Russian roulette
+// on throughput without the 1/η² of refraction), and adds Σ w·L and Σ w
+// to its pixel (filter importance sampling: w = f/pdf).
+
+// What one dispatch renders: samples [first_sample, first_sample +
+// samples) of the rows from pixel_offset on.
+struct FrameUniform {
+    width: u32,
+    height: u32,
+    first_sample: u32,
+    samples: u32,
+    pixel_offset: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}
+
+// The scene header at the start of module_params (upload.rs, Header).
+const H_ROOT: u32 = 0u;
+const H_CAMERA: u32 = 1u;
+const H_SAMPLER: u32 = 2u;
+const H_FILTER: u32 = 3u;
+const H_FILTER_RES: u32 = 4u;
+const H_FILTER_RADIUS: u32 = 5u;
+const H_FILTER_INTEGRAL: u32 = 6u;
+const H_MATERIALS: u32 = 7u;
+const H_TEXTURES: u32 = 8u;
+const H_LIGHTS: u32 = 9u;
+const H_LIGHT_COUNT: u32 = 10u;
+const H_LIGHT_CDF: u32 = 11u;
+
+@group(0) @binding(0) var<uniform> frame: FrameUniform;
+@group(0) @binding(1) var<storage, read> module_params: array<u32>;
+@group(0) @binding(2) var<storage, read> nodes: array<vec4f>;
+@group(0) @binding(3) var<storage, read> prims: array<vec4f>;
+@group(0) @binding(4) var<storage, read> shading: array<vec4f>;
+@group(0) @binding(5) var<storage, read> instances: array<vec4f>;
+@group(0) @binding(6) var<storage, read_write> film: array<vec4f>;
+@group(0) @binding(7) var<storage, read_write> counters: array<atomic<u32>>;
+
+// Longest path in segments (16384 for unlimited), and the depth from
+// which Russian roulette applies.
+override MAX_DEPTH: u32 = 8u;
+override RR_DEPTH: u32 = 5u;
+
+const CAMERA_DIMS: u32 = 4u;
+const BOUNCE_DIMS: u32 = 8u;
+const SHADOW_EPSILON: f32 = 1e-4;
+const NO_EMITTER: u32 = 0xffffffffu;
+
+fn sample_2d(pixel: u32, index: u32, dim: u32) -> vec2f {
+    return vec2f(sample_1d(pixel, index, dim), sample_1d(pixel, index, dim + 1u));
+}
+
+// An offset from the pixel centre drawn from the tabulated filter
+// (rows: marginal CDF; then per row its CDF; then the signs), and its
+// weight f/pdf.
+fn filter_cdf(i: u32) -> f32 {
+    return param_f32(param_u32(H_FILTER) + i);
+}
+
+// Index of the first entry of cdf[at .. at + n] above u (n ≥ 1).
+fn find_interval(at: u32, n: u32, u: f32) -> u32 {
+    var lo = 0u;
+    var hi = n - 1u;
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        if filter_cdf(at + mid) <= u {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+fn filter_sample(u: vec2f) -> vec3f {
+    let res = param_u32(H_FILTER_RES);
+    let row = find_interval(0u, res, u.y);
+    let row_lo = select(0.0, filter_cdf(row - 1u), row > 0u);
+    let row_hi = filter_cdf(row);
+    let fy = clamp((u.y - row_lo) / max(row_hi - row_lo, 1e-30), 0.0, 1.0);
+    let at = res + row * res;
+    let col = find_interval(at, res, u.x);
+    let col_lo = select(0.0, filter_cdf(at + col - 1u), col > 0u);
+    let col_hi = filter_cdf(at + col);
+    let fx = clamp((u.x - col_lo) / max(col_hi - col_lo, 1e-30), 0.0, 1.0);
+    let cell = vec2f(f32(col) + fx, f32(row) + fy) / f32(res);
+    let offset = (2.0 * cell - vec2f(1.0)) * param_f32(H_FILTER_RADIUS);
+    let sgn = filter_cdf(res + res * res + row * res + col);
+    return vec3f(offset, param_f32(H_FILTER_INTEGRAL) * sgn);
+}
+
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    let a2 = a * a;
+    let b2 = b * b;
+    return select(0.0, a2 / (a2 + b2), a2 + b2 > 0.0);
+}
+
+fn bsdf_hit_weight(depth: u32, bsdf_pdf: f32, light_pdf: f32) -> f32 {
+    if depth == 0u || bsdf_pdf == 0.0 {
+        return 1.0;
+    }
+    return power_heuristic(bsdf_pdf, light_pdf);
+}
+
+fn light_word(l: u32, i: u32) -> u32 {
+    return param_u32(param_u32(H_LIGHTS) + 4u * l + i);
+}
+
+// (light, probability) for the uniform sample u, as LightTable::select.
+fn select_light(u: f32) -> vec2f {
+    let n = param_u32(H_LIGHT_COUNT);
+    var lo = 0u;
+    var hi = n - 1u;
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        if param_f32(param_u32(H_LIGHT_CDF) + mid) <= u {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return vec2f(f32(lo), bitcast<f32>(light_word(lo, 3u)));
+}
+
+fn sampled_point_error(p: vec3f) -> vec3f {
+    return abs(p) * GAMMA7;
+}
+
+// Radiance of one camera path, and its filter weight in w; adds the rays
+// it traced to `rays`.
+fn trace_path(px: u32, py: u32, index: u32, rays: ptr<function, u32>) -> vec4f {
+    let pixel = py * frame.width + px;
+    let fs = filter_sample(sample_2d(pixel, index, 0u));
+    let film_pos = vec2f(f32(px), f32(py)) + vec2f(0.5) + fs.xy;
+    let ray = camera_ray(film_pos, sample_2d(pixel, index, 2u));
+    var o = ray.origin;
+    var d = ray.dir;
+    var beta = vec3f(ray.weight);
+    var eta_scale = 1.0;
+    var radiance = vec3f(0.0);
+    var prev_pdf = 0.0;
+    var depth = 0u;
+    loop {
+        *rays += 1u;
+        let hit = closest_hit(o, d);
+        if hit.slot == NO_HIT {
+//#if ENVIRONMENT
+            radiance += beta * escaped_radiance(normalize(d), depth, prev_pdf);
+//#endif
+            break;
+        }
+        let it = interaction(hit, o, d);
+//#if AREA_LIGHTS
+        if it.emitter != NO_EMITTER {
+            let e = light_hit(it.emitter, EmitterHit(o, it.p, it.ng, it.emitter_prim));
+            let pmf = bitcast<f32>(light_word(it.emitter, 3u));
+            radiance += beta * e.radiance * bsdf_hit_weight(depth, prev_pdf, pmf * e.pdf);
+        }
+//#endif
+        if depth + 1u >= MAX_DEPTH {
+            break;
+        }
+        let base = CAMERA_DIMS + depth * BOUNCE_DIMS;
+        let sp = ShadingPoint(to_local(it.frame, -d), it.uv);
+        let material = it.material;
+//#if LIGHTS
+        // Next-event estimation: a light in proportion to power, a point
+        // on it, and the shadow ray towards it.
+        var light = 0u;
+        var light_prob = 1.0;
+        if param_u32(H_LIGHT_COUNT) > 1u {
+            let choice = select_light(sample_1d(pixel, index, base));
+            light = u32(choice.x);
+            light_prob = choice.y;
+        }
+        let ls = light_sample(light, it.p, sample_2d(pixel, index, base + 1u));
+        let to_light = ls.p - it.p;
+        let to_light_len = length(to_light);
+        var wi_world = vec3f(0.0);
+        if to_light_len > 0.0 {
+            wi_world = to_light / to_light_len;
+        }
+        let wi_local = to_local(it.frame, wi_world);
+        if ls.pdf > 0.0 && material_has_smooth_lobes(material)
+            && dot(wi_world, it.ng) * wi_local.z > 0.0 {
+            let e = bsdf_eval(material, sp, wi_local);
+            if any(e.value != vec3f(0.0)) {
+                let light_pdf = light_prob * ls.pdf;
+                var weight = light_pdf / (light_pdf * light_pdf + e.pdf * e.pdf);
+                if light_word(light, 2u) != 0u {
+                    weight = 1.0 / light_pdf;
+                }
+                let value = beta * e.value * ls.radiance * weight;
+                if any(value != vec3f(0.0)) && is_finite_vec3(value) {
+                    let origin = offset_origin(it.p, it.err, it.ng, wi_world);
+                    var target_point = ls.p;
+                    if any(ls.n != vec3f(0.0)) {
+                        target_point = offset_origin(ls.p, sampled_point_error(ls.p), ls.n, -wi_world);
+                    }
+                    *rays += 1u;
+                    if !occluded(origin, target_point - origin, 1.0 - SHADOW_EPSILON) {
+                        radiance += value;
+                    }
+                }
+            }
+        }
+//#endif
+        let u1 = sample_1d(pixel, index, base + 3u);
+        let bs = bsdf_sample(material, sp, vec3f(u1, sample_2d(pixel, index, base + 4u)));
+        if bs.pdf <= 0.0 || all(bs.weight == vec3f(0.0)) {
+            break;
+        }
+        let wi = to_world(it.frame, bs.wi);
+        if dot(wi, it.ng) * bs.wi.z <= 0.0 {
+            break;
+        }
+        beta *= bs.weight;
+        let beta_max = max(beta.x, max(beta.y, beta.z));
+        if beta_max <= 0.0 || !is_finite_vec3(beta) {
+            break;
+        }
+        eta_scale *= bs.eta * bs.eta;
+        let survival = beta_max * eta_scale;
+        if depth + 1u >= RR_DEPTH && survival < 1.0 {
+            if sample_1d(pixel, index, base + 6u) >= survival {
+                break;
+            }
+            beta /= survival;
+        }
+        prev_pdf = select(bs.pdf, 0.0, bs.delta);
+        o = offset_origin(it.p, it.err, it.ng, wi);
+        d = wi;
+        depth++;
+    }
+    return vec4f(radiance, fs.z);
+}
+
+// Rays and invalid samples of the workgroup, added to the counters once.
+var<workgroup> group_rays: atomic<u32>;
+var<workgroup> group_invalid: atomic<u32>;
+
+// One invocation traces one path: pixel (x, y + pixel_offset), sample
+// first_sample + z, added to film layer z (each invocation of a dispatch
+// owns its film entry, so no atomics; the host sums the layers).
+@compute @workgroup_size(8, 8, 1)
+fn render(@builtin(global_invocation_id) gid: vec3u, @builtin(local_invocation_index) local: u32) {
+    let px = gid.x;
+    let py = gid.y + frame.pixel_offset;
+    let in_frame = px < frame.width && py < frame.height && gid.z < frame.samples;
+    var rays = 0u;
+    if in_frame {
+        let r = trace_path(px, py, frame.first_sample + gid.z, &rays);
+        let at = (gid.z * frame.height + py) * frame.width + px;
+        if is_finite_vec3(r.xyz) {
+            film[at] += vec4f(r.xyz * r.w, r.w);
+        } else {
+            film[at].w += r.w;
+            atomicAdd(&group_invalid, 1u);
+        }
+        atomicAdd(&group_rays, rays);
+    }
+    workgroupBarrier();
+    if local == 0u {
+        atomicAdd(&counters[0], atomicLoad(&group_invalid));
+        atomicAdd(&counters[1], atomicLoad(&group_rays));
+    }
+}
