@@ -174,6 +174,7 @@ pub fn check_against(image: &Image, reference: &Image, block: u32) -> ReferenceC
 }
 
 pub mod chi2;
+pub mod gpu;
 pub mod shading;
 
 /// Tolerances of a comparison with a converged reference.

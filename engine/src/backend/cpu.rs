@@ -129,8 +129,8 @@ pub fn render_samples(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::film::Image;
     use crate::extract::{Overrides, extract};
+    use crate::film::Image;
     use std::path::Path;
 
     /// Renders the Cornell box at `width`² pixels and `spp` on a pool of

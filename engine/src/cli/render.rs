@@ -230,7 +230,7 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         }
         let secs = rendered.time.as_secs_f64();
         let line = format!(
-            "rendered {}x{}, {} spp in {:.2} s ({:.2} Msamples/s, {:.2} Mrays/s)",
+            "rendered {}x{}, {} spp in {:.3} s ({:.2} Msamples/s, {:.2} Mrays/s)",
             settings.width,
             settings.height,
             settings.spp,

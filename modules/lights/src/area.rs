@@ -280,7 +280,7 @@ impl Light for AreaLight {
             let record = match *part {
                 Part::Triangle([a, b, c], n) => head(0).vec3(a).vec3(b).vec3(c).vec3(n),
                 Part::Rectangle(r) => head(1).vec3(r.corner).vec3(r.ex).vec3(r.ey).vec3(r.n),
-                Part::Sphere(centre, radius) => head(2).vec3(centre).f32(radius).f32s([0.0; 6]),
+                Part::Sphere(centre, radius) => head(2).vec3(centre).f32(radius).f32s([0.0; 8]),
             };
             debug_assert_eq!(record.len(), 15);
             params = params.append(&record).f32(0.0);

@@ -48,7 +48,7 @@ impl Features {
             textures: scene.effects.contains(Effects::TEXTURES),
             lights: !scene.lights.is_empty(),
             area_lights: modules.area_lights,
-            environment: false,
+            environment: modules.environment,
         }
     }
 
@@ -125,6 +125,44 @@ impl Kernel {
             parts: Vec::new(),
             features,
         };
+        k.modules(modules);
+        k.part("the generated dispatchers", &dispatchers(modules));
+        k.part(
+            "the GPU backend's geometry (wgsl/geometry.wgsl)",
+            &preprocess(GEOMETRY, &features),
+        );
+        k.part(
+            "the GPU backend's path integrator (wgsl/path.wgsl)",
+            &preprocess(PATH, &features),
+        );
+        k
+    }
+
+    /// A kernel that runs `body` once per probe input (see
+    /// [`super::probe`]): the prelude, `modules`' code, the texture
+    /// dispatcher, and an entry point around `body`.
+    pub fn assemble_probe(modules: &Modules, body: &str) -> Self {
+        let mut k = Kernel {
+            source: String::new(),
+            parts: Vec::new(),
+            features: Features::default(),
+        };
+        k.part(
+            "the probe's bindings",
+            "@group(0) @binding(0) var<storage, read> module_params: array<u32>;\n\
+             @group(0) @binding(1) var<storage, read> probe_in: array<f32>;\n\
+             @group(0) @binding(2) var<storage, read_write> probe_out: array<f32>;\n\
+             const H_TEXTURES: u32 = 8u;\n",
+        );
+        k.modules(modules);
+        k.part("the generated dispatchers", &dispatchers(modules));
+        k.part("the probe", body);
+        k
+    }
+
+    /// The prelude, the libraries the modules call and the modules' code.
+    fn modules(&mut self, modules: &Modules) {
+        let k = self;
         k.part(
             "the module prelude (radiant-core)",
             radiant_core::gpu::PRELUDE,
@@ -152,16 +190,6 @@ impl Kernel {
                 k.part(&format!("the {kind} module `{}`", t.ident), &t.wgsl);
             }
         }
-        k.part("the generated dispatchers", &dispatchers(modules));
-        k.part(
-            "the GPU backend's geometry (wgsl/geometry.wgsl)",
-            &preprocess(GEOMETRY, &features),
-        );
-        k.part(
-            "the GPU backend's path integrator (wgsl/path.wgsl)",
-            &preprocess(PATH, &features),
-        );
-        k
     }
 
     fn part(&mut self, name: &str, source: &str) {
@@ -237,16 +265,23 @@ fn dispatcher(
 /// The generated entry points the integrator calls.
 fn dispatchers(m: &Modules) -> String {
     let mut s = String::new();
-    let cam = &m.camera.types[0].ident;
-    let smp = &m.sampler.types[0].ident;
-    let _ = writeln!(
-        s,
-        "fn camera_ray(film: vec2f, lens: vec2f) -> CameraRay {{\n    return camera_ray_{cam}(param_u32(H_CAMERA), film, lens);\n}}\n"
-    );
-    let _ = writeln!(
-        s,
-        "fn sample_1d(pixel: u32, index: u32, dim: u32) -> f32 {{\n    return sample_1d_{smp}(param_u32(H_SAMPLER), pixel, index, dim);\n}}\n"
-    );
+    if let [cam] = m.camera.types.as_slice() {
+        let _ = writeln!(
+            s,
+            "fn camera_ray(film: vec2f, lens: vec2f) -> CameraRay {{\n    return camera_ray_{}(param_u32(H_CAMERA), film, lens);\n}}\n",
+            cam.ident
+        );
+    }
+    if let [smp] = m.sampler.types.as_slice() {
+        let _ = writeln!(
+            s,
+            "fn sample_1d(pixel: u32, index: u32, dim: u32) -> f32 {{\n    return sample_1d_{}(param_u32(H_SAMPLER), pixel, index, dim);\n}}\n",
+            smp.ident
+        );
+    }
+    if m.shaders.types.is_empty() {
+        return texture_dispatcher(m, s);
+    }
     let material = "vec2u(param_u32(param_u32(H_MATERIALS) + 4u * m), param_u32(param_u32(H_MATERIALS) + 4u * m + 1u))";
     dispatcher(
         &mut s,
@@ -268,21 +303,7 @@ fn dispatchers(m: &Modules) -> String {
         s,
         "fn material_has_smooth_lobes(m: u32) -> bool {{\n    return param_u32(param_u32(H_MATERIALS) + 4u * m + 2u) != 0u;\n}}\n"
     );
-    let texture = "vec2u(param_u32(param_u32(H_TEXTURES) + 4u * id), param_u32(param_u32(H_TEXTURES) + 4u * id + 1u))";
-    dispatcher(
-        &mut s,
-        "texture_eval(id: u32, uv: vec2f) -> vec3f",
-        texture,
-        "texture",
-        ", uv",
-        &tagged(&m.textures),
-    );
-    if m.textures.types.is_empty() {
-        let _ = writeln!(
-            s,
-            "fn texture_eval(id: u32, uv: vec2f) -> vec3f {{\n    return vec3f(0.0);\n}}\n"
-        );
-    }
+    s = texture_dispatcher(m, s);
     if !m.lights.types.is_empty() {
         let light = "vec2u(param_u32(param_u32(H_LIGHTS) + 4u * l), param_u32(param_u32(H_LIGHTS) + 4u * l + 1u))";
         dispatcher(
@@ -314,6 +335,45 @@ fn dispatchers(m: &Modules) -> String {
             );
             s.push_str(&hit);
         }
+        if m.environment {
+            // Only lights at infinity are asked: dispatch among those types.
+            let escaped_types: Vec<(u32, &str)> = tagged(&m.lights)
+                .into_iter()
+                .filter(|(tag, t)| {
+                    m.lights.types[*tag as usize]
+                        .wgsl
+                        .contains(&format!("fn light_escaped_{t}("))
+                })
+                .collect();
+            dispatcher(
+                &mut s,
+                "light_escaped(l: u32, dir: vec3f) -> EmitterEval",
+                light,
+                "light_escaped",
+                ", dir",
+                &escaped_types,
+            );
+        }
+    }
+    s
+}
+
+/// `texture_eval`, appended to `s`.
+fn texture_dispatcher(m: &Modules, mut s: String) -> String {
+    let texture = "vec2u(param_u32(param_u32(H_TEXTURES) + 4u * id), param_u32(param_u32(H_TEXTURES) + 4u * id + 1u))";
+    dispatcher(
+        &mut s,
+        "texture_eval(id: u32, uv: vec2f) -> vec3f",
+        texture,
+        "texture",
+        ", uv",
+        &tagged(&m.textures),
+    );
+    if m.textures.types.is_empty() {
+        let _ = writeln!(
+            s,
+            "fn texture_eval(id: u32, uv: vec2f) -> vec3f {{\n    return vec3f(0.0);\n}}\n"
+        );
     }
     s
 }

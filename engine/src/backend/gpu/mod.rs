@@ -15,6 +15,7 @@ mod device;
 pub mod error;
 pub mod kernel;
 pub mod modules;
+pub mod probe;
 pub mod upload;
 
 pub use device::GpuOptions;

@@ -9,14 +9,14 @@
 
 use super::error::GpuError;
 use crate::extract::RenderScene;
-use radiant_core::{Effects, Filter, GpuLibrary, GpuModule, TextureId, TextureRef};
+use radiant_core::{Effects, Filter, GpuLibrary, GpuModule, TextureId, TextureRef, TextureTable};
 
 /// Cells per axis of the tabulated filter.
 const FILTER_RES: u32 = 64;
 
 /// Words of the header at the start of the parameter buffer (the `H_*`
 /// constants of `wgsl/path.wgsl`).
-const HEADER_WORDS: usize = 12;
+const HEADER_WORDS: usize = 14;
 
 /// One module type of a kind, as the kernel includes it.
 #[derive(Debug, Clone, PartialEq)]
@@ -72,6 +72,10 @@ pub struct Modules {
     pub textures: KindTypes,
     /// Whether the lights include surface emitters that rays hit.
     pub area_lights: bool,
+    /// Whether the lights include lights at infinity that escaped rays
+    /// see (their indices follow the light CDF: header word 12 says where,
+    /// word 13 how many).
+    pub environment: bool,
 }
 
 /// The built-in texture type of constant values.
@@ -111,7 +115,7 @@ impl Modules {
         m.params[2] = m.push(&sampler);
         m.filter_table(scene.filter.as_ref());
         m.materials(scene)?;
-        m.textures(scene)?;
+        m.textures(&scene.textures)?;
         m.lights(scene)?;
         Ok(m)
     }
@@ -196,11 +200,11 @@ impl Modules {
     }
 
     /// The textures' directory: (type, offset, 0, 0) per texture.
-    fn textures(&mut self, scene: &RenderScene) -> Result<(), GpuError> {
+    fn textures(&mut self, textures: &TextureTable) -> Result<(), GpuError> {
         let constant = GpuModule::new("constant", CONSTANT_TEXTURE, Default::default());
-        let mut entries = Vec::with_capacity(4 * scene.textures.len());
-        for i in 0..scene.textures.len() as u32 {
-            let module = match scene.textures.get(TextureId(i)) {
+        let mut entries = Vec::with_capacity(4 * textures.len());
+        for i in 0..textures.len() as u32 {
+            let module = match textures.get(TextureId(i)) {
                 TextureRef::Constant(c) => GpuModule {
                     params: radiant_core::GpuParams::new().rgb(c),
                     ..constant.clone()
@@ -231,9 +235,7 @@ impl Modules {
                 name: format!("#{}", i + 1),
                 type_name: scene.light_types.get(i).cloned().unwrap_or_default(),
             })?;
-            if light.effects().contains(Effects::ENVIRONMENT) {
-                return Err(GpuError::Unsupported("an environment light".into()));
-            }
+            self.environment |= light.effects().contains(Effects::ENVIRONMENT);
             self.area_lights |= light.effects().contains(Effects::AREA_LIGHTS);
             let tag = self.lights.tag(&module);
             let at = self.push(&module);
@@ -258,7 +260,38 @@ impl Modules {
             };
             self.params.push(c.to_bits());
         }
+        self.params[12] = self.params.len() as u32;
+        self.params[13] = table.environment().len() as u32;
+        self.params
+            .extend(table.environment().iter().map(|&i| i as u32));
         Ok(())
+    }
+
+    /// The parameter block of a probe ([`super::probe`]): the header and
+    /// the texture directory of `textures`, then `module`'s parameters,
+    /// whose offset is returned; `module`'s type is listed under `kind`'s
+    /// types so that the kernel includes its code.
+    pub(super) fn for_probe(
+        textures: &TextureTable,
+        module: &GpuModule,
+        kind: super::probe::ProbeKind,
+    ) -> Result<(Self, u32), GpuError> {
+        let mut m = Modules {
+            params: vec![0; HEADER_WORDS],
+            ..Modules::default()
+        };
+        m.textures(textures)?;
+        let at = m.push(module);
+        use super::probe::ProbeKind;
+        let types = match kind {
+            ProbeKind::Camera => &mut m.camera,
+            ProbeKind::Sampler => &mut m.sampler,
+            ProbeKind::Shader => &mut m.shaders,
+            ProbeKind::Light => &mut m.lights,
+            ProbeKind::Texture => &mut m.textures,
+        };
+        types.tag(module);
+        Ok((m, at))
     }
 
     /// Every module type in use, by kind, for `radiant info`.

@@ -31,6 +31,8 @@ const H_TEXTURES: u32 = 8u;
 const H_LIGHTS: u32 = 9u;
 const H_LIGHT_COUNT: u32 = 10u;
 const H_LIGHT_CDF: u32 = 11u;
+const H_ENVIRONMENT: u32 = 12u;
+const H_ENVIRONMENT_COUNT: u32 = 13u;
 
 @group(0) @binding(0) var<uniform> frame: FrameUniform;
 @group(0) @binding(1) var<storage, read> module_params: array<u32>;
@@ -126,6 +128,22 @@ fn select_light(u: f32) -> vec2f {
     }
     return vec2f(f32(lo), bitcast<f32>(light_word(lo, 3u)));
 }
+
+//#if ENVIRONMENT
+// Radiance of the lights at infinity along the escaped direction `dir`,
+// MIS-weighted against light sampling (integrators/path.rs add_escaped).
+fn escaped_radiance(dir: vec3f, depth: u32, prev_pdf: f32) -> vec3f {
+    var sum = vec3f(0.0);
+    let n = param_u32(H_ENVIRONMENT_COUNT);
+    for (var k = 0u; k < n; k++) {
+        let l = param_u32(param_u32(H_ENVIRONMENT) + k);
+        let e = light_escaped(l, dir);
+        let pmf = bitcast<f32>(light_word(l, 3u));
+        sum += e.radiance * bsdf_hit_weight(depth, prev_pdf, pmf * e.pdf);
+    }
+    return sum;
+}
+//#endif
 
 fn sampled_point_error(p: vec3f) -> vec3f {
     return abs(p) * GAMMA7;

@@ -1,0 +1,54 @@
+//! Helpers of the GPU backend's tests: one adapter per test binary (the
+//! tests of a binary take turns on it), and renders of the same scene by
+//! both backends.
+//!
+//! CI has no GPU: `.ci/run` installs Mesa's lavapipe, on which these run.
+//! Without any adapter the tests fail, saying so.
+
+use radiant::backend::cpu::{Progress, render};
+use radiant::backend::gpu::{GpuBackend, GpuOptions};
+use radiant::extract::{Overrides, RenderScene, extract};
+use radiant::film::Image;
+use radiant::settings::FilterSampling;
+use std::sync::{Mutex, MutexGuard, OnceLock};
+
+/// The test binary's GPU backend.
+pub fn backend() -> MutexGuard<'static, GpuBackend> {
+    static BACKEND: OnceLock<Mutex<GpuBackend>> = OnceLock::new();
+    let b =
+        BACKEND.get_or_init(|| {
+            // `expect` in this test code is the assertion: CI installs lavapipe,
+            // so an adapter must be found.
+            Mutex::new(GpuBackend::new(&GpuOptions::default()).expect(
+                "a GPU adapter (install mesa-vulkan-drivers for lavapipe, as .ci/run does)",
+            ))
+        });
+    // A test that panicked while holding the lock leaves a usable backend.
+    b.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// `scene` (relative to the workspace root) extracted with `overrides`,
+/// the film filtered by importance sampling as the GPU does.
+pub fn extract_scene(scene: &str, overrides: &Overrides) -> RenderScene {
+    let loaded = radiant::scene::load(crate::root().join(scene)).expect("scene loads");
+    let overrides = Overrides {
+        filter_sampling: Some(FilterSampling::Importance),
+        ..overrides.clone()
+    };
+    extract(&loaded, &radiant::builtin_registry(), &overrides).expect("scene extracts")
+}
+
+/// The GPU's and the CPU's renders of `scene`: the same estimator, sampler
+/// and filter sampling, so the same expectation.
+pub fn render_both(scene: &str, overrides: &Overrides) -> (Image, Image) {
+    let r = extract_scene(scene, overrides);
+    let gpu = backend()
+        .render(&r, &Progress::none())
+        .unwrap_or_else(|e| panic!("{scene}: the GPU render failed: {e}"));
+    assert_eq!(
+        gpu.invalid_samples, 0,
+        "{scene}: NaN or infinite GPU samples"
+    );
+    let cpu = render(&r, &Progress::none());
+    (gpu.image, cpu.image)
+}
