@@ -74,11 +74,6 @@ fn torture_grazing_plane() {
 }
 
 #[test]
-fn torture_mirror_box() {
-    agrees("scenes/hard/mirror-box.yaml", 48, 64, CLOSE);
-}
-
-#[test]
 fn point_light() {
     agrees("scenes/hard/tiny-light-point.yaml", 48, 64, CLOSE);
 }

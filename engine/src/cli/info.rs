@@ -1,9 +1,71 @@
 //! `radiant info`: what a scene contains and what it needs.
 
 use super::diagnostic::report;
+use clap::Args;
 use radiant::Registry;
-use radiant::extract::{Overrides, extract};
-use std::path::Path;
+use radiant::backend::gpu::Plan;
+use radiant::extract::{Overrides, RenderScene, extract};
+use std::path::{Path, PathBuf};
+
+/// Options of `radiant info`.
+#[derive(Args)]
+pub struct InfoArgs {
+    /// The scene file.
+    scene: PathBuf,
+    /// With `gpu`, also list what the GPU kernel of the scene compiles in
+    /// (module types, features); fails, naming it, where a module has no
+    /// GPU code.
+    #[arg(long, value_enum, default_value_t = InfoBackend::Cpu)]
+    backend: InfoBackend,
+    /// Write the scene's generated GPU kernel to DIR/kernel.wgsl (implies
+    /// `--backend gpu`).
+    #[arg(long, value_name = "DIR")]
+    dump_wgsl: Option<PathBuf>,
+}
+
+/// The backends `radiant info` can describe.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum InfoBackend {
+    /// The scene alone.
+    Cpu,
+    /// The scene and its GPU kernel.
+    Gpu,
+}
+
+/// Prints what the GPU kernel of `r` compiles in; writes it to
+/// `dump/kernel.wgsl` if asked.
+fn gpu_kernel(r: &RenderScene, dump: Option<&Path>) -> miette::Result<()> {
+    let plan = Plan::new(r).map_err(|e| miette::miette!("{e}"))?;
+    for (kind, types) in plan.modules.summary() {
+        if !types.is_empty() {
+            println!("gpu {kind:<9} {}", types.join(", "));
+        }
+    }
+    let features = plan.kernel.features.names();
+    println!(
+        "gpu features {}",
+        if features.is_empty() {
+            "none".to_string()
+        } else {
+            features.join(", ")
+        }
+    );
+    println!(
+        "gpu kernel   {} lines of WGSL, {} BVH nodes, {} primitives",
+        plan.kernel.source.lines().count(),
+        plan.geometry.nodes.len(),
+        plan.geometry.prims.len() / 4
+    );
+    if let Some(dir) = dump {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| miette::miette!("cannot create `{}`: {e}", dir.display()))?;
+        let file = dir.join("kernel.wgsl");
+        std::fs::write(&file, &plan.kernel.source)
+            .map_err(|e| miette::miette!("cannot write `{}`: {e}", file.display()))?;
+        println!("gpu source   {}", file.display());
+    }
+    Ok(())
+}
 
 /// What besides shapes animates: the camera, lights, materials and
 /// textures with keyframes.
@@ -42,8 +104,10 @@ fn animated_modules(scene: &radiant::scene::Scene) -> Vec<String> {
     out
 }
 
-/// Prints counts, modules and effects of the scene at `path`.
-pub fn run(registry: &Registry, path: &Path) -> miette::Result<()> {
+/// Prints counts, modules and effects of the scene `args.scene`, and with
+/// `--backend gpu` its GPU kernel.
+pub fn run(registry: &Registry, args: &InfoArgs) -> miette::Result<()> {
+    let path = &args.scene;
     let scene = radiant::scene::load(path).map_err(report)?;
     let r = extract(&scene, registry, &Overrides::default()).map_err(report)?;
     let s = &r.settings;
@@ -113,5 +177,8 @@ pub fn run(registry: &Registry, path: &Path) -> miette::Result<()> {
         "instances    {} in the top level ({} instanced shapes), {} triangles placed",
         st.instances, st.instanced_shapes, st.instanced_triangles
     );
+    if args.backend == InfoBackend::Gpu || args.dump_wgsl.is_some() {
+        gpu_kernel(&r, args.dump_wgsl.as_deref())?;
+    }
     Ok(())
 }

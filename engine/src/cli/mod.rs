@@ -27,10 +27,7 @@ enum Command {
     /// Measure error against time for a sweep of settings (CSV, plot, summary).
     Accuracy(accuracy::AccuracyArgs),
     /// Print a scene's triangle and light counts, modules and effect set.
-    Info {
-        /// The scene file.
-        scene: PathBuf,
-    },
+    Info(info::InfoArgs),
     /// List every registered module type with its parameters and defaults.
     Modules,
     /// Show rendered frames as a contact sheet (.png) or an animated GIF (.gif).
@@ -57,7 +54,7 @@ pub fn run() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render::run(&registry, &args),
         Command::Accuracy(args) => accuracy::run(&registry, &args),
-        Command::Info { scene } => info::run(&registry, &scene),
+        Command::Info(args) => info::run(&registry, &args),
         Command::Sheet(args) => sheet::run(&args),
         Command::Modules => {
             modules::run(&registry);

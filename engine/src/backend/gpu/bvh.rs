@@ -57,10 +57,12 @@ pub fn build_level(boxes: &[Option<Aabb>], first_slot: u32, nodes: &mut Vec<Node
 /// One child's two `vec4f`.
 type Child = [[f32; 4]; 2];
 
-/// A child that no ray enters (an inverted box).
+/// A child that holds nothing: an inner reference to no node (`u32::MAX`,
+/// which traversal treats as nothing to visit; a box test alone cannot
+/// reject it, since slab tests take an inverted box for the whole space).
 fn empty_child() -> Child {
     [
-        [f32::MAX, f32::MAX, f32::MAX, 0.0],
+        [f32::MAX, f32::MAX, f32::MAX, f32::from_bits(u32::MAX)],
         [-f32::MAX, -f32::MAX, -f32::MAX, 0.0],
     ]
 }
@@ -139,7 +141,8 @@ mod tests {
                 for c in [0, 2] {
                     let (lo, hi) = (nd[c], nd[c + 1]);
                     let (reference, count) = (lo[3].to_bits(), hi[3].to_bits());
-                    if lo[0] > hi[0] {
+                    if reference == u32::MAX {
+                        assert_eq!(count, 0);
                         continue;
                     }
                     if count == 0 {

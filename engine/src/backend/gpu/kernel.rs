@@ -160,6 +160,53 @@ impl Kernel {
         k
     }
 
+    /// A kernel that traces given rays through the geometry of `features`
+    /// (closest hit and occlusion), for tests of traversal against the CPU
+    /// (see [`super::GpuBackend::trace_rays`]).
+    pub fn assemble_trace(features: Features) -> Self {
+        let mut k = Kernel {
+            source: String::new(),
+            parts: Vec::new(),
+            features,
+        };
+        k.part(
+            "the tracer's bindings",
+            "@group(0) @binding(0) var<storage, read> module_params: array<u32>;\n\
+             @group(0) @binding(1) var<storage, read> nodes: array<vec4f>;\n\
+             @group(0) @binding(2) var<storage, read> prims: array<vec4f>;\n\
+             @group(0) @binding(3) var<storage, read> shading: array<vec4f>;\n\
+             @group(0) @binding(4) var<storage, read> instances: array<vec4f>;\n\
+             @group(0) @binding(5) var<storage, read> rays: array<vec4f>;\n\
+             @group(0) @binding(6) var<storage, read_write> hits: array<vec4f>;\n\
+             const H_ROOT: u32 = 0u;\n",
+        );
+        k.part(
+            "the module prelude (radiant-core)",
+            radiant_core::gpu::PRELUDE,
+        );
+        k.part(
+            "the GPU backend's geometry (wgsl/geometry.wgsl)",
+            &preprocess(GEOMETRY, &features),
+        );
+        k.part(
+            "the tracer",
+            "@compute @workgroup_size(64)\n\
+             fn trace(@builtin(global_invocation_id) g: vec3u) {\n\
+             \x20   let i = g.x;\n\
+             \x20   if i >= arrayLength(&rays) / 2u { return; }\n\
+             \x20   let o = rays[2u * i].xyz;\n\
+             \x20   let tmax = rays[2u * i].w;\n\
+             \x20   let d = rays[2u * i + 1u].xyz;\n\
+             \x20   let h = closest_hit(o, d);\n\
+             \x20   var prim = 0xffffffffu;\n\
+             \x20   if h.slot != NO_HIT { prim = prim_info(h.slot).w; }\n\
+             \x20   let blocked = select(0.0, 1.0, occluded(o, d, tmax));\n\
+             \x20   hits[i] = vec4f(h.t, bitcast<f32>(prim), blocked, 0.0);\n\
+             }\n",
+        );
+        k
+    }
+
     /// The prelude, the libraries the modules call and the modules' code.
     fn modules(&mut self, modules: &Modules) {
         let k = self;

@@ -16,6 +16,7 @@ pub mod error;
 pub mod kernel;
 pub mod modules;
 pub mod probe;
+pub mod trace;
 pub mod upload;
 
 pub use device::GpuOptions;

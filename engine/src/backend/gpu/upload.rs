@@ -24,9 +24,9 @@ pub struct Geometry {
     pub nodes: Vec<Node>,
     /// Primitives, four `vec4f` each.
     pub prims: Vec<Vec4>,
-    /// Shading data, four `vec4f` per primitive (vertex normals with the
-    /// texture coordinates in their `w`s; for spheres, the rows of the
-    /// rotation to the sphere's object space).
+    /// Shading data, four `vec4f` per primitive in the CPU's numbering
+    /// (vertex normals with the texture coordinates in their `w`s; for
+    /// spheres, the rows of the rotation to the sphere's object space).
     pub shading: Vec<Vec4>,
     /// Instances, ten `vec4f` each (empty without a top level).
     pub instances: Vec<Vec4>,
@@ -57,6 +57,8 @@ impl Geometry {
         let accel = &scene.accel;
         let surfaces = &scene.surfaces;
         let mut g = Geometry::default();
+        let total: usize = accel.blases().iter().map(|b| b.len()).sum();
+        g.shading = vec![[0.0; 4]; 4 * total];
         let mut roots = Vec::with_capacity(accel.blases().len());
         for (b, blas) in accel.blases().iter().enumerate() {
             if blas.deforms() {
@@ -85,7 +87,7 @@ impl Geometry {
                     surfaces.material[k],
                     emitter,
                     surfaces.emitter_prim.get(k).copied().unwrap_or(0),
-                    (g.shading.len() / 4) as u32,
+                    id,
                 ];
                 g.prims.extend([
                     vec4(a, f32::from_bits(kind)),
@@ -95,7 +97,7 @@ impl Geometry {
                 ]);
                 let n = surfaces.normals[k];
                 let uv = surfaces.uvs.get(k).copied().unwrap_or_default();
-                g.shading.extend([
+                g.shading[4 * k..4 * k + 4].copy_from_slice(&[
                     vec4(n[0], uv[0].x),
                     vec4(n[1], uv[0].y),
                     vec4(n[2], uv[1].x),

@@ -4,9 +4,11 @@
 //
 // Nodes are 4 vec4f: both children's boxes, each with a reference (a node
 // index, or the first primitive slot of a leaf) and a primitive count
-// (0: inner). Primitives are 4 vec4f: v0 (kind in w: 0 triangle, 1
-// sphere), v1, v2 (sphere: centre and radius in v0), then (material,
-// emitter, emitter primitive, shading index) as bits.
+// (0: inner). An inner reference of NO_HIT is an empty child: it becomes
+// `next` and is dropped like a missed box. Primitives are 4 vec4f: v0 (kind in w: 0 triangle, 1
+// sphere), v1, v2 (sphere: centre in v0, radius in v1.x), then
+// (material, emitter, emitter primitive, primitive number) as bits; the
+// primitive number (the CPU's) indexes the shading data.
 
 const STACK_SIZE: u32 = 48u;
 const NO_HIT: u32 = 0xffffffffu;
@@ -62,6 +64,7 @@ fn hit_triangle(slot: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>) -> bool
     return false;
 }
 
+//#if SPHERES
 // Haines et al.'s precise ray–sphere test (accel/sphere.rs).
 fn hit_sphere(slot: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>) -> bool {
     let c = prims[4u * slot].xyz;
@@ -98,6 +101,7 @@ fn hit_sphere(slot: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>) -> bool {
     }
     return false;
 }
+//#endif
 
 fn hit_primitive(slot: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>) -> bool {
 //#if SPHERES
