@@ -77,3 +77,33 @@ fn torture_grazing_plane() {
 fn point_light() {
     agrees("scenes/hard/tiny-light-point.yaml", 48, 64, CLOSE);
 }
+
+#[test]
+fn plastic() {
+    agrees("scenes/plastic.yaml", 48, 64, CLOSE);
+}
+
+#[test]
+fn environment() {
+    agrees("scenes/environment.yaml", 48, 64, CLOSE);
+}
+
+#[test]
+fn spot_and_directional_lights() {
+    agrees("scenes/spot-directional.yaml", 48, 64, CLOSE);
+}
+
+#[test]
+fn depth_of_field() {
+    agrees("scenes/depth-of-field.yaml", 48, 64, CLOSE);
+}
+
+#[test]
+fn textured_mesh() {
+    agrees("tests/data/uv/mesh.yaml", 48, 64, CLOSE);
+}
+
+#[test]
+fn torture_glass_ior_1() {
+    agrees("scenes/hard/glass-ior-1.yaml", 48, 64, CLOSE);
+}

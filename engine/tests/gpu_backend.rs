@@ -134,6 +134,7 @@ fn traversal_matches_the_cpu_through_instances() {
 fn an_adapter_without_a_needed_limit_is_refused_naming_the_limit() {
     let options = GpuOptions {
         storage_buffer_bytes: Some(u64::MAX),
+        ..GpuOptions::default()
     };
     match GpuBackend::new(&options) {
         Err(e @ GpuError::Limit { .. }) => {
@@ -166,7 +167,11 @@ fn a_compile_error_names_the_module_whose_code_caused_it() {
     };
     match backend().probe(&probe, &[0.0]) {
         Err(GpuError::Compile { module, message }) => {
-            assert_eq!(module.as_deref(), Some("the texture module `broken`"), "{message}");
+            assert_eq!(
+                module.as_deref(),
+                Some("the texture module `broken`"),
+                "{message}"
+            );
             assert!(message.contains("undefined_name"), "{message}");
         }
         Err(e) => panic!("expected a compile error, got: {e}"),

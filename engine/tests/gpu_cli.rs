@@ -69,7 +69,10 @@ fn a_diffuse_scene_compiles_no_code_it_does_not_use_and_glass_brings_the_dielect
         "trace_scene",
         "ggx_",
     ] {
-        assert!(!diffuse.contains(absent), "`{absent}` in a diffuse-only kernel");
+        assert!(
+            !diffuse.contains(absent),
+            "`{absent}` in a diffuse-only kernel"
+        );
     }
     let dir = tempfile::tempdir().unwrap();
     let glass = edited_cornell(dir.path(), |t| {
@@ -83,8 +86,14 @@ fn a_diffuse_scene_compiles_no_code_it_does_not_use_and_glass_brings_the_dielect
         )
     });
     let kernel = kernel_of(&glass);
-    assert!(kernel.contains("fn bsdf_sample_dielectric("), "no dielectric");
-    assert!(kernel.contains("fn fresnel_dielectric("), "no Fresnel library");
+    assert!(
+        kernel.contains("fn bsdf_sample_dielectric("),
+        "no dielectric"
+    );
+    assert!(
+        kernel.contains("fn fresnel_dielectric("),
+        "no Fresnel library"
+    );
     assert!(!kernel.contains("fn bsdf_sample_conductor("));
 }
 
@@ -118,7 +127,9 @@ fn a_module_without_gpu_code_is_named_and_nothing_is_written() {
     let err = stderr(&o);
     assert!(!o.status.success());
     assert!(
-        err.contains("material `white`") && err.contains("`normal_map`") && err.contains("no GPU code"),
+        err.contains("material `white`")
+            && err.contains("`normal_map`")
+            && err.contains("no GPU code"),
         "{err}"
     );
     assert!(!out.exists(), "an image was written");
@@ -144,7 +155,10 @@ fn a_module_without_gpu_code_is_named_and_nothing_is_written() {
     );
     let err = stderr(&o);
     assert!(o.status.success(), "{err}");
-    assert!(err.contains("backend: cpu") && err.contains("normal_map"), "{err}");
+    assert!(
+        err.contains("backend: cpu") && err.contains("normal_map"),
+        "{err}"
+    );
     assert!(out.exists());
 }
 
@@ -211,6 +225,10 @@ fn the_gpu_renders_the_default_scene_from_the_command_line() {
         &[],
     );
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stderr(&o).contains("rendered 32x24, 4 spp"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("rendered 32x24, 4 spp"),
+        "{}",
+        stderr(&o)
+    );
     assert!(out.exists());
 }

@@ -33,7 +33,7 @@ pub fn extract_scene(scene: &str, overrides: &Overrides) -> RenderScene {
     let loaded = radiant::scene::load(crate::root().join(scene)).expect("scene loads");
     let overrides = Overrides {
         filter_sampling: Some(FilterSampling::Importance),
-        ..overrides.clone()
+        ..*overrides
     };
     extract(&loaded, &radiant::builtin_registry(), &overrides).expect("scene extracts")
 }

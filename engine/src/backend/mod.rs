@@ -78,6 +78,12 @@ pub trait Backend: Send {
         scene: &RenderScene,
         progress: &Progress<'_>,
     ) -> Result<Rendered, RenderError>;
+
+    /// What the last render counted beyond [`Rendered`], as a line for
+    /// the user (the GPU's rays by kind and traversal work), if anything.
+    fn counts(&self) -> Option<String> {
+        None
+    }
 }
 
 /// The CPU backend on the current rayon pool.
@@ -110,6 +116,23 @@ impl Backend for gpu::GpuBackend {
     ) -> Result<Rendered, RenderError> {
         Ok(gpu::GpuBackend::render(self, scene, progress)?)
     }
+
+    fn counts(&self) -> Option<String> {
+        let s = self.last_stats();
+        let rays = (s.camera_rays + s.bounce_rays + s.shadow_rays).max(1) as f64;
+        let mut line = format!(
+            "rays: {} camera, {} bounce, {} shadow",
+            s.camera_rays, s.bounce_rays, s.shadow_rays
+        );
+        if s.nodes > 0 {
+            line += &format!(
+                "; per ray {:.1} nodes visited, {:.1} primitives tested",
+                s.nodes as f64 / rays,
+                s.prims as f64 / rays
+            );
+        }
+        Some(line)
+    }
 }
 
 /// Which backend renders (`--backend`).
@@ -126,10 +149,11 @@ pub enum BackendKind {
     Auto,
 }
 
-/// The backend `kind` asks for, for frames like `scene`; `note` receives
-/// what `auto` chose and why.
+/// The backend `kind` asks for (a GPU opened with `options`), for frames
+/// like `scene`; `note` receives what `auto` chose and why.
 pub fn choose(
     kind: BackendKind,
+    options: &gpu::GpuOptions,
     scene: &RenderScene,
     note: &mut dyn FnMut(String),
 ) -> Result<Box<dyn Backend>, gpu::GpuError> {
@@ -137,14 +161,14 @@ pub fn choose(
         BackendKind::Cpu => Ok(Box::new(CpuBackend)),
         BackendKind::Gpu => {
             gpu::Plan::new(scene)?;
-            Ok(Box::new(gpu::GpuBackend::new(&gpu::GpuOptions::default())?))
+            Ok(Box::new(gpu::GpuBackend::new(options)?))
         }
         BackendKind::Auto => {
             if let Err(e) = gpu::Plan::new(scene) {
                 note(format!("backend: cpu ({e})"));
                 return Ok(Box::new(CpuBackend));
             }
-            match gpu::GpuBackend::new(&gpu::GpuOptions::default()) {
+            match gpu::GpuBackend::new(options) {
                 Ok(g) if !g.is_software() => {
                     note(format!("backend: gpu, adapter {}", g.adapter()));
                     Ok(Box::new(g))

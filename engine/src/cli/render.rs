@@ -49,6 +49,10 @@ pub struct RenderArgs {
     /// adapter can render the scene, else the CPU; says which on stderr).
     #[arg(long, value_enum, default_value_t = BackendKind::Auto)]
     backend: BackendKind,
+    /// On the GPU, count traversal work too (nodes visited, primitives
+    /// tested per ray; slows rendering) and print the rays by kind.
+    #[arg(long)]
+    gpu_stats: bool,
     #[command(flatten)]
     film: FilmArgs,
 }
@@ -197,8 +201,16 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         let backend = match &mut backend {
             Some(b) => b,
             None => backend.insert(
-                choose(args.backend, s, &mut |note| eprintln!("{note}"))
-                    .map_err(|e| miette::miette!("{e}"))?,
+                choose(
+                    args.backend,
+                    &radiant::backend::gpu::GpuOptions {
+                        stats: args.gpu_stats,
+                        ..Default::default()
+                    },
+                    s,
+                    &mut |note| eprintln!("{note}"),
+                )
+                .map_err(|e| miette::miette!("{e}"))?,
             ),
         };
         let per_frame = settings.width as u64 * settings.height as u64 * settings.spp as u64;
@@ -249,6 +261,11 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
             });
         } else {
             bar.suspend(|| eprintln!("{line}"));
+        }
+        if args.gpu_stats
+            && let Some(counts) = backend.counts()
+        {
+            bar.suspend(|| eprintln!("{counts}"));
         }
         totals.frames += 1;
         totals.update += update.update;

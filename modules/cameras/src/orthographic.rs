@@ -5,9 +5,9 @@
 //! aspect ratio; the default 2 is Mitsuba 3's [−1, 1] window, which a scale
 //! in the camera's `transform` resizes in both renderers.
 
-use crate::projection::{InvalidParam, Raster, check_min};
+use crate::projection::{InvalidParam, Raster, check_min, gpu_pose};
 use radiant_core::glam::{Mat4, Vec2, Vec3};
-use radiant_core::{Camera, CameraRays, ParamDoc, Registry};
+use radiant_core::{Camera, CameraRays, GpuModule, ParamDoc, Registry};
 use serde::Deserialize;
 
 #[derive(Debug, Deserialize)]
@@ -48,11 +48,17 @@ impl Orthographic {
             half,
         })
     }
+
+    /// The direction of every ray: the pose's +z, normalised.
+    #[inline]
+    fn direction(&self) -> Vec3 {
+        self.to_render.transform_vector3(Vec3::Z).normalize()
+    }
 }
 
 impl Camera for Orthographic {
     fn generate(&self, film: &[Vec2], _lens: &[Vec2], out: CameraRays<'_>) {
-        let dir = self.to_render.transform_vector3(Vec3::Z).normalize();
+        let dir = self.direction();
         for (i, p) in film.iter().enumerate() {
             let ndc = self.raster.ndc(*p);
             // Camera space +x is left, NDC +x is right.
@@ -61,6 +67,20 @@ impl Camera for Orthographic {
             out.directions[i] = dir;
             out.weights[i] = 1.0;
         }
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let params = self
+            .raster
+            .gpu_params(gpu_pose(&self.to_render))
+            .f32(self.half.x)
+            .f32(self.half.y)
+            .vec3(self.direction());
+        Some(GpuModule::new(
+            "orthographic",
+            include_str!("orthographic.wgsl"),
+            params,
+        ))
     }
 }
 

@@ -1,10 +1,10 @@
 //! The `perspective` camera: an ideal pinhole.
 
 use crate::projection::{
-    FOV_AXIS_DOC, FOV_DOC, FovAxis, InvalidParam, Pinhole, central_rays, default_fov,
+    FOV_AXIS_DOC, FOV_DOC, FovAxis, InvalidParam, Pinhole, central_rays, default_fov, gpu_pose,
 };
-use radiant_core::glam::{Mat4, Vec2, Vec3};
-use radiant_core::{Camera, CameraRays, GpuModule, GpuParams, ParamDoc, Registry};
+use radiant_core::glam::{Mat4, Vec2};
+use radiant_core::{Camera, CameraRays, GpuModule, ParamDoc, Registry};
 use serde::Deserialize;
 
 #[derive(Debug, Deserialize)]
@@ -49,16 +49,10 @@ impl Camera for Perspective {
     }
 
     fn gpu(&self) -> Option<GpuModule> {
-        let m = self.to_render;
-        let params = GpuParams::new()
-            .vec3(m.transform_point3(Vec3::ZERO))
-            .vec3(m.x_axis.truncate())
-            .vec3(m.y_axis.truncate())
-            .vec3(m.z_axis.truncate());
         Some(GpuModule::new(
             "perspective",
             include_str!("perspective.wgsl"),
-            self.pinhole.gpu_params(params),
+            self.pinhole.gpu_params(gpu_pose(&self.to_render)),
         ))
     }
 }

@@ -62,6 +62,11 @@ impl Raster {
         }
     }
 
+    /// Appends the raster scale (2 / resolution, two words) for WGSL.
+    pub(crate) fn gpu_params(&self, params: GpuParams) -> GpuParams {
+        params.f32(self.scale.x).f32(self.scale.y)
+    }
+
     /// Raster pixels (top-left origin, +y down) to NDC ([−1, 1]², +y up).
     #[inline]
     pub(crate) fn ndc(&self, p: Vec2) -> Vec2 {
@@ -112,24 +117,35 @@ impl Pinhole {
         })
     }
 
-    /// The camera-space point (x, y) on the plane z = 1 that raster
-    /// position `p` looks through.
-    #[inline]
-    /// Appends what `pinhole_plane_point` in WGSL reads: the raster scale,
-    /// then tan(fov/2) per axis.
+    /// Appends what the cameras' WGSL reads of the image plane: the
+    /// raster scale, then tan(fov/2) per axis.
     pub(crate) fn gpu_params(&self, params: GpuParams) -> GpuParams {
-        params
-            .f32(self.raster.scale.x)
-            .f32(self.raster.scale.y)
+        self.raster
+            .gpu_params(params)
             .f32(self.tan_half.x)
             .f32(self.tan_half.y)
     }
 
+    /// The camera-space point (x, y) on the plane z = 1 that raster
+    /// position `p` looks through.
+    #[inline]
     pub(crate) fn plane_point(&self, p: Vec2) -> Vec2 {
         let ndc = self.raster.ndc(p);
         // Camera space +x is left, NDC +x is right.
         Vec2::new(-ndc.x * self.tan_half.x, ndc.y * self.tan_half.y)
     }
+}
+
+/// The pose `to_render` for WGSL: its origin (translation), then its x,
+/// y and z axes (twelve words), which the cameras' WGSL applies as
+/// [`Mat4::transform_point3`] and [`Mat4::transform_vector3`] do
+/// (origin + x·p.x + y·p.y + z·p.z, and the same without the origin).
+pub(crate) fn gpu_pose(to_render: &Mat4) -> GpuParams {
+    GpuParams::new()
+        .vec3(to_render.transform_point3(Vec3::ZERO))
+        .vec3(to_render.x_axis.truncate())
+        .vec3(to_render.y_axis.truncate())
+        .vec3(to_render.z_axis.truncate())
 }
 
 /// Writes the rays of a central projection: from the pose's origin along

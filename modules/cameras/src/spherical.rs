@@ -8,9 +8,9 @@
 //! (φ, λ) rectangle, so rays are unweighted and the image is radiance
 //! per direction, as an environment map stores it.
 
-use crate::projection::central_rays;
+use crate::projection::{central_rays, gpu_pose};
 use radiant_core::glam::{Mat4, Vec2, Vec3};
-use radiant_core::{Camera, CameraRays, Registry};
+use radiant_core::{Camera, CameraRays, GpuModule, GpuParams, Registry};
 use serde::Deserialize;
 use std::f32::consts::{PI, TAU};
 
@@ -48,6 +48,18 @@ impl Spherical {
 impl Camera for Spherical {
     fn generate(&self, film: &[Vec2], _lens: &[Vec2], out: CameraRays<'_>) {
         central_rays(&self.to_render, film, out, |p| self.direction(p));
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let params = GpuParams::new()
+            .append(&gpu_pose(&self.to_render))
+            .f32(self.resolution.x)
+            .f32(self.resolution.y);
+        Some(GpuModule::new(
+            "spherical",
+            include_str!("spherical.wgsl"),
+            params,
+        ))
     }
 }
 

@@ -8,11 +8,11 @@
 //! `thinlens`).
 
 use crate::projection::{
-    FOV_AXIS_DOC, FOV_DOC, FovAxis, InvalidParam, Pinhole, check_min, default_fov,
+    FOV_AXIS_DOC, FOV_DOC, FovAxis, InvalidParam, Pinhole, check_min, default_fov, gpu_pose,
 };
 use radiant_core::glam::{Mat4, Vec2};
 use radiant_core::warp::square_to_disk_concentric;
-use radiant_core::{Camera, CameraRays, Effects, ParamDoc, Registry};
+use radiant_core::{Camera, CameraRays, Effects, GpuModule, ParamDoc, Registry};
 use serde::Deserialize;
 
 #[derive(Debug, Deserialize)]
@@ -100,6 +100,19 @@ impl Camera for ThinLens {
 
     fn effects(&self) -> Effects {
         Effects::DEPTH_OF_FIELD
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let params = self
+            .pinhole
+            .gpu_params(gpu_pose(&self.to_render))
+            .f32(self.aperture_radius)
+            .f32(self.focus_distance);
+        Some(GpuModule::new(
+            "thin_lens",
+            include_str!("thin_lens.wgsl"),
+            params,
+        ))
     }
 }
 

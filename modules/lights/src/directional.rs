@@ -6,8 +6,8 @@ use crate::delta::sample_delta;
 use crate::params::{axis, check_colour};
 use radiant_core::glam::{DVec3, Vec2, Vec3};
 use radiant_core::{
-    BoundingSphere, BuildContext, Color, Effects, Light, LightSample, Numbers, ParamDoc,
-    ParamError, Params, Registry, Rgb, luminance,
+    BoundingSphere, BuildContext, Color, Effects, GpuModule, GpuParams, Light, LightSample,
+    Numbers, ParamDoc, ParamError, Params, Registry, Rgb, luminance,
 };
 use serde::Deserialize;
 
@@ -52,6 +52,13 @@ impl DirectionalLight {
             sphere,
         }
     }
+
+    /// From a reference point to its sample point: against the direction
+    /// of travel, twice the scene's radius (outside the scene).
+    #[inline]
+    fn back(&self) -> Vec3 {
+        self.direction * (-2.0 * self.sphere.radius)
+    }
 }
 
 impl Light for DirectionalLight {
@@ -65,12 +72,21 @@ impl Light for DirectionalLight {
     }
 
     fn sample(&self, refs: &[Vec3], _u: &[Vec2], out: &mut [LightSample]) {
-        let back = self.direction * (-2.0 * self.sphere.radius);
+        let back = self.back();
         sample_delta(refs, out, |r| (r + back, self.irradiance));
     }
 
     fn effects(&self) -> Effects {
         Effects::DELTA_LIGHTS
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let params = GpuParams::new().vec3(self.back()).rgb(self.irradiance);
+        Some(GpuModule::new(
+            "directional",
+            include_str!("directional.wgsl"),
+            params,
+        ))
     }
 }
 

@@ -14,6 +14,12 @@
 //! times the cell's band of cos θ), sampled with a [`Distribution2D`];
 //! within a cell, φ and cos θ are uniform, so the density is constant over
 //! each cell's solid angle.
+//!
+//! The GPU side (`environment.wgsl`) samples and evaluates the same way from
+//! the same tables: the map's texels, cos θ per row, and the marginal and
+//! conditional CDFs of the distribution, rebuilt here exactly as
+//! [`Distribution1D`](radiant_core::distribution::Distribution1D) builds
+//! them (a test holds the two to the same densities and samples).
 
 use crate::map_file::load_map;
 use crate::params::check_colour;
@@ -21,13 +27,13 @@ use radiant_core::distribution::Distribution2D;
 use radiant_core::glam::{DMat3, Mat3, UVec2, Vec2, Vec3};
 use radiant_core::warp::{UNIFORM_SPHERE_PDF, square_to_uniform_sphere};
 use radiant_core::{
-    BoundingSphere, Color, Effects, EmitterEval, Light, LightSample, ModuleInfo, ParamDoc,
-    ParamError, Params, Registry, Rgb, luminance,
+    BoundingSphere, Color, Effects, EmitterEval, GpuModule, GpuParams, Light, LightSample,
+    ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb, luminance,
 };
 use serde::Deserialize;
 use std::f32::consts::{PI, TAU};
 use std::path::PathBuf;
-use std::sync::{Arc, Mutex, Weak};
+use std::sync::{Arc, Mutex, OnceLock, Weak};
 use std::time::SystemTime;
 
 #[derive(Deserialize)]
@@ -73,6 +79,19 @@ struct Map {
     /// cos θ of each pixel row.
     cos_theta: Vec<f32>,
     distribution: Distribution2D,
+    /// The GPU parameters of the map, made on first use.
+    gpu: GpuCache,
+}
+
+/// Parameters made once and kept with the map they were made from; every
+/// cache equals every other (a map's equality is its data's).
+#[derive(Debug, Clone, Default)]
+struct GpuCache(OnceLock<GpuParams>);
+
+impl PartialEq for GpuCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -190,17 +209,7 @@ impl EnvironmentLight {
         let cos_theta: Vec<f32> = (0..h)
             .map(|y| (PI * y as f32 / (h - 1) as f32).cos())
             .collect();
-        let lum: Vec<f32> = pixels.iter().map(|p| luminance(*p)).collect();
-        let mut weights = Vec::with_capacity(w * (h - 1));
-        for y in 0..h - 1 {
-            let band = (cos_theta[y] - cos_theta[y + 1]).max(0.0);
-            for x in 0..w {
-                let x1 = (x + 1) % w;
-                let corners =
-                    lum[y * w + x] + lum[y * w + x1] + lum[(y + 1) * w + x] + lum[(y + 1) * w + x1];
-                weights.push(0.25 * corners * band);
-            }
-        }
+        let weights = cell_weights(&pixels, size, &cos_theta);
         let distribution = Distribution2D::new(&weights, UVec2::new(size.x, size.y - 1));
         let integral = (TAU / w as f32) * distribution.total() as f32;
         Ok(Self {
@@ -209,6 +218,7 @@ impl EnvironmentLight {
                 texels: pixels,
                 cos_theta,
                 distribution,
+                gpu: GpuCache::default(),
             })),
             to_render,
             to_light: to_render.transpose(),
@@ -239,7 +249,79 @@ impl EnvironmentLight {
     }
 }
 
+/// The sampling weight of each of the `size.x × (size.y − 1)` cells
+/// between pixel centres: the mean luminance of its four corners times
+/// its band of cos θ.
+fn cell_weights(pixels: &[Rgb], size: UVec2, cos_theta: &[f32]) -> Vec<f32> {
+    let (w, h) = (size.x as usize, size.y as usize);
+    let lum: Vec<f32> = pixels.iter().map(|p| luminance(*p)).collect();
+    let mut weights = Vec::with_capacity(w * (h - 1));
+    for y in 0..h - 1 {
+        let band = (cos_theta[y] - cos_theta[y + 1]).max(0.0);
+        for x in 0..w {
+            let x1 = (x + 1) % w;
+            let corners =
+                lum[y * w + x] + lum[y * w + x1] + lum[(y + 1) * w + x] + lum[(y + 1) * w + x1];
+            weights.push(0.25 * corners * band);
+        }
+    }
+    weights
+}
+
+/// The cumulative distribution of `weights` as
+/// [`Distribution1D::new`](radiant_core::distribution::Distribution1D::new)
+/// computes it (`n + 1` entries from 0 to 1; uniform if all are zero),
+/// appended to `out`.
+fn push_cdf(weights: &[f32], out: &mut Vec<f32>) {
+    let n = weights.len().max(1);
+    let total: f64 = weights.iter().map(|&w| w.max(0.0) as f64).sum();
+    out.push(0.0);
+    let mut acc = 0.0f64;
+    for i in 0..n {
+        acc += if total > 0.0 {
+            weights.get(i).map_or(0.0, |&w| w.max(0.0) as f64) / total
+        } else {
+            1.0 / n as f64
+        };
+        out.push(if i + 1 == n { 1.0 } else { acc as f32 });
+    }
+}
+
 impl Map {
+    /// The map's words for `environment.wgsl` (see its header): size,
+    /// the offsets of the tables, then cos θ per row, the marginal CDF of
+    /// the cell rows, each cell row's conditional CDF and the texels.
+    fn gpu_params(&self) -> &GpuParams {
+        self.gpu.0.get_or_init(|| {
+            let (w, h) = (self.size.x as usize, self.size.y as usize);
+            let weights = cell_weights(&self.texels, self.size, &self.cos_theta);
+            let mut rows = Vec::with_capacity((h - 1) * (w + 1));
+            let mut totals = Vec::with_capacity(h - 1);
+            for row in weights.chunks_exact(w) {
+                totals.push(row.iter().map(|&x| x.max(0.0) as f64).sum::<f64>() as f32);
+                push_cdf(row, &mut rows);
+            }
+            let mut marginal = Vec::with_capacity(h);
+            push_cdf(&totals, &mut marginal);
+            // Offsets from the light's first word: 17 words precede the tables.
+            let cos_at = 17;
+            let marginal_at = cos_at + h;
+            let rows_at = marginal_at + marginal.len();
+            let texels_at = rows_at + rows.len();
+            GpuParams::new()
+                .u32(self.size.x)
+                .u32(self.size.y)
+                .u32(cos_at as u32)
+                .u32(marginal_at as u32)
+                .u32(rows_at as u32)
+                .u32(texels_at as u32)
+                .f32s(self.cos_theta.iter().copied())
+                .f32s(marginal)
+                .f32s(rows)
+                .f32s(self.texels.iter().flat_map(|t| t.to_array()))
+        })
+    }
+
     /// Bilinear interpolation between pixels, wrapping in u.
     #[inline]
     fn lookup(&self, u: f32, v: f32) -> Rgb {
@@ -343,6 +425,24 @@ impl Light for EnvironmentLight {
         for (d, o) in dirs.iter().zip(out.iter_mut()) {
             *o = self.eval_local(self.to_light * *d);
         }
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let m = self.to_render;
+        let head = GpuParams::new()
+            .f32(2.0 * self.sphere.radius)
+            .vec3(m.x_axis)
+            .vec3(m.y_axis)
+            .vec3(m.z_axis);
+        let params = match &self.emission {
+            Emission::Constant(c) => head.u32(0).rgb(*c),
+            Emission::Map(map) => head.u32(1).append(map.gpu_params()),
+        };
+        Some(GpuModule::new(
+            "environment",
+            include_str!("environment.wgsl"),
+            params,
+        ))
     }
 
     fn effects(&self) -> Effects {
@@ -452,6 +552,94 @@ mod tests {
         registry
             .build::<dyn Light>("environment", &params, &mut ctx)
             .expect("the sky map builds")
+    }
+
+    /// Distribution1D::sample on the CDF `cdf` (n + 1 entries), as
+    /// `env_sample_1d` in environment.wgsl.
+    fn sample_cdf(cdf: &[f32], u: f32) -> (usize, f32) {
+        let n = cdf.len() - 1;
+        let i = cdf.partition_point(|&c| c <= u).clamp(1, n) - 1;
+        let width = cdf[i + 1] - cdf[i];
+        let rest = if width > 0.0 {
+            ((u - cdf[i]) / width).clamp(0.0, 0.999_999_94)
+        } else {
+            0.5
+        };
+        (i, rest)
+    }
+
+    #[test]
+    fn gpu_tables_give_the_distributions_densities_and_samples() {
+        // Two black rows make a cell row of weight zero, two black columns
+        // a zero cell in every row.
+        let (w, h) = (7u32, 6u32);
+        let pixels = (0..w * h)
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                if y == 2 || y == 3 || x == 3 || x == 4 {
+                    Rgb::ZERO
+                } else {
+                    Rgb::new(0.3 * x as f32 + 0.1, y as f32, 0.01 * (x * y) as f32 + 0.5)
+                }
+            })
+            .collect();
+        let sphere = BoundingSphere {
+            centre: Vec3::ZERO,
+            radius: 1.0,
+        };
+        // `expect` in this test code is the assertion: the map is valid.
+        let light = EnvironmentLight::from_pixels(pixels, UVec2::new(w, h), Mat3::IDENTITY, sphere)
+            .expect("a valid map");
+        let Emission::Map(map) = &light.emission else {
+            panic!("from_pixels makes a map")
+        };
+        // The map's words start at the light's word 11; the offsets count
+        // from the light's first word.
+        let words = map.gpu_params().words();
+        let table = |k: usize, len: usize| -> Vec<f32> {
+            let at = words[k] as usize - 11;
+            words[at..at + len]
+                .iter()
+                .map(|&b| f32::from_bits(b))
+                .collect()
+        };
+        let (wu, rows) = (w as usize, h as usize - 1);
+        assert_eq!(table(2, h as usize), map.cos_theta);
+        let marginal = table(3, rows + 1);
+        let conditional = table(4, rows * (wu + 1));
+        for y in 0..rows {
+            let row = &conditional[y * (wu + 1)..(y + 1) * (wu + 1)];
+            for x in 0..wu {
+                let pdf = (marginal[y + 1] - marginal[y])
+                    * (row[x + 1] - row[x])
+                    * (w * rows as u32) as f32;
+                let cell = UVec2::new(x as u32, y as u32);
+                assert_eq!(
+                    pdf.to_bits(),
+                    map.distribution.pdf(cell).to_bits(),
+                    "{cell}"
+                );
+            }
+        }
+        for i in 0..4096 {
+            let u = Vec2::new(
+                ((i % 64) as f32 + 0.37) / 64.0,
+                ((i / 64) as f32 + 0.61) / 64.0,
+            );
+            let (y, ry) = sample_cdf(&marginal, u.y);
+            let (x, rx) = sample_cdf(&conditional[y * (wu + 1)..(y + 1) * (wu + 1)], u.x);
+            let p = Vec2::new((x as f32 + rx) / w as f32, (y as f32 + ry) / rows as f32);
+            let expected = map.distribution.sample(u);
+            assert_eq!((p, UVec2::new(x as u32, y as u32)), expected, "u = {u}");
+        }
+        let texels = table(5, (w * h * 3) as usize);
+        assert_eq!(
+            texels,
+            map.texels
+                .iter()
+                .flat_map(|t| t.to_array())
+                .collect::<Vec<_>>()
+        );
     }
 
     #[test]

@@ -6,8 +6,8 @@ use crate::delta::sample_delta;
 use crate::params::{axis, check_colour, place};
 use radiant_core::glam::{DVec3, Vec2, Vec3};
 use radiant_core::{
-    BuildContext, Color, Effects, Light, LightSample, Numbers, ParamDoc, ParamError, Params,
-    Registry, Rgb, luminance,
+    BuildContext, Color, Effects, GpuModule, GpuParams, Light, LightSample, Numbers, ParamDoc,
+    ParamError, Params, Registry, Rgb, luminance,
 };
 use serde::Deserialize;
 
@@ -146,6 +146,15 @@ impl Light for SpotLight {
 
     fn effects(&self) -> Effects {
         Effects::DELTA_LIGHTS
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let params = GpuParams::new()
+            .vec3(self.position)
+            .vec3(self.axis)
+            .rgb(self.intensity)
+            .f32s([self.cutoff, self.beam, self.cos_cutoff, self.cos_beam]);
+        Some(GpuModule::new("spot", include_str!("spot.wgsl"), params))
     }
 }
 

@@ -18,9 +18,12 @@ use crate::load::{LoadError, Texels, load};
 use crate::wrap::WrapMode;
 use radiant_core::glam::Vec2;
 use radiant_core::{
-    BuildContext, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb, Texture,
+    BuildContext, GpuModule, GpuParams, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb,
+    Texture,
 };
 use serde::Deserialize;
+use std::collections::HashMap;
+use std::sync::OnceLock;
 
 /// How lookups between texel centres are reconstructed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
@@ -40,7 +43,23 @@ pub struct ImageTexture {
     filtering: Filtering,
     wrap: WrapMode,
     mean: Rgb,
+    /// The GPU parameters, made on first use.
+    gpu: GpuCache,
 }
+
+/// Parameters made once and kept with the texture they were made from;
+/// every cache equals every other (a texture's equality is its data's).
+#[derive(Debug, Clone, Default)]
+struct GpuCache(OnceLock<GpuParams>);
+
+impl PartialEq for GpuCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+/// Most distinct channel values a palette holds (8-bit indices).
+const PALETTE: usize = 256;
 
 impl ImageTexture {
     /// A texture over `texels` (at least one texel).
@@ -59,7 +78,42 @@ impl ImageTexture {
             filtering,
             wrap,
             mean,
+            gpu: GpuCache::default(),
         }
+    }
+
+    /// The words of `image.wgsl` (see its header): size, filtering, wrap
+    /// mode, then the texels — as indices into a palette of the distinct
+    /// channel values where there are at most 256 (every 8-bit image, sRGB
+    /// or raw: one word per texel, the values exactly those of the Rust
+    /// side), else as three floats each.
+    fn gpu_params(&self) -> &GpuParams {
+        self.gpu.0.get_or_init(|| {
+            let t = &self.texels;
+            let head = GpuParams::new()
+                .u32(t.width)
+                .u32(t.height)
+                .u32(match self.filtering {
+                    Filtering::Bilinear => 0,
+                    Filtering::Nearest => 1,
+                })
+                .u32(match self.wrap {
+                    WrapMode::Repeat => 0,
+                    WrapMode::Clamp => 1,
+                    WrapMode::Mirror => 2,
+                });
+            match palette(&t.data) {
+                Some((values, index)) if t.data.len() > values.len() => {
+                    let i = |x: f32| index[&x.to_bits()] as u32;
+                    t.data
+                        .iter()
+                        .fold(head.u32(values.len() as u32).f32s(values), |params, c| {
+                            params.u32(i(c.x) | (i(c.y) << 8) | (i(c.z) << 16))
+                        })
+                }
+                _ => head.u32(0).f32s(t.data.iter().flat_map(|c| c.to_array())),
+            }
+        })
     }
 
     #[inline]
@@ -103,6 +157,23 @@ fn texel_coordinate(c: f32) -> f32 {
     }
 }
 
+/// The distinct channel values of `data` (by bits) and each one's index,
+/// if there are at most [`PALETTE`].
+fn palette(data: &[Rgb]) -> Option<(Vec<f32>, HashMap<u32, u8>)> {
+    let mut values = Vec::new();
+    let mut index = HashMap::new();
+    for c in data.iter().flat_map(|c| c.to_array()) {
+        if let std::collections::hash_map::Entry::Vacant(e) = index.entry(c.to_bits()) {
+            if values.len() == PALETTE {
+                return None;
+            }
+            e.insert(values.len() as u8);
+            values.push(c);
+        }
+    }
+    Some((values, index))
+}
+
 impl Texture for ImageTexture {
     fn eval(&self, uv: &[Vec2], out: &mut [Rgb]) {
         for (o, p) in out.iter_mut().zip(uv) {
@@ -112,6 +183,14 @@ impl Texture for ImageTexture {
 
     fn mean(&self) -> Rgb {
         self.mean
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        Some(GpuModule::new(
+            "image",
+            include_str!("image.wgsl"),
+            self.gpu_params().clone(),
+        ))
     }
 }
 

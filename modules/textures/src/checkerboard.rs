@@ -1,26 +1,38 @@
 //! The `checkerboard` texture: 2 × 2 checks over the unit square, repeated
 //! (Mitsuba 3's checkerboard); `color0` where ⌊2u⌋ + ⌊2v⌋ is even.
 
-use crate::compose::{CHUNK, chunked, grid_mean, resolve};
+use crate::compose::{CHUNK, COMPOSE, Child, GpuCache, chunked, composite_gpu, grid_mean, resolve};
 use radiant_core::glam::Vec2;
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BuildContext, ModuleInfo, ParamDoc, Params, Registry, Rgb, Texture, TextureInput, TextureRef,
+    BuildContext, GpuLibrary, GpuModule, GpuParams, ModuleInfo, ParamDoc, Params, Registry, Rgb,
+    Texture, TextureInput,
 };
 use serde::Deserialize;
 
 /// A checkerboard of two textures.
 pub struct Checkerboard {
-    colors: [TextureRef; 2],
+    colors: [Child; 2],
     mean: Rgb,
+    gpu: GpuCache,
 }
 
+/// The checkerboard's WGSL helpers (`checkerboard_odd`), shared by its
+/// instances of every combination of child types.
+const CHECKS: GpuLibrary = GpuLibrary {
+    name: "textures::checkerboard",
+    wgsl: include_str!("checkerboard_lib.wgsl"),
+    requires: &[],
+};
+
 impl Checkerboard {
-    /// A checkerboard of `color0` and `color1`.
-    pub fn new(color0: TextureRef, color1: TextureRef) -> Self {
+    /// A checkerboard of `color0` and `color1` (a [`TextureRef`](radiant_core::TextureRef) or,
+    /// for a GPU side with a varying input, a [`Child`] with its id).
+    pub fn new(color0: impl Into<Child>, color1: impl Into<Child>) -> Self {
         let mut t = Self {
-            colors: [color0, color1],
+            colors: [color0.into(), color1.into()],
             mean: Rgb::ZERO,
+            gpu: GpuCache::default(),
         };
         t.mean = grid_mean(|uv, out| t.eval(uv, out));
         t
@@ -50,6 +62,18 @@ impl Texture for Checkerboard {
 
     fn mean(&self) -> Rgb {
         self.mean
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        self.gpu.get(|| {
+            composite_gpu(
+                "checkerboard",
+                include_str!("checkerboard.wgsl"),
+                &[COMPOSE, CHECKS],
+                GpuParams::new(),
+                &[&self.colors[0], &self.colors[1]],
+            )
+        })
     }
 }
 

@@ -2,7 +2,9 @@
 //! become constants without any module).
 
 use radiant_core::glam::Vec2;
-use radiant_core::{Color, Effects, ModuleInfo, ParamDoc, Params, Registry, Rgb, Texture};
+use radiant_core::{
+    Color, Effects, GpuModule, GpuParams, ModuleInfo, ParamDoc, Params, Registry, Rgb, Texture,
+};
 use serde::Deserialize;
 
 /// A texture with the same value everywhere.
@@ -26,6 +28,16 @@ impl Texture for Constant {
 
     fn effects(&self) -> Effects {
         Effects::empty()
+    }
+
+    /// The engine's own constant type (a table holds constants as values,
+    /// so this is only asked of an instance held elsewhere): its value.
+    fn gpu(&self) -> Option<GpuModule> {
+        Some(GpuModule::new(
+            "constant",
+            "fn texture_constant(p: u32, uv: vec2f) -> vec3f {\n    return param_vec3(p);\n}\n",
+            GpuParams::new().rgb(self.value),
+        ))
     }
 }
 

@@ -1,30 +1,35 @@
 //! The `layered` texture of seed 004: `upper` over `lower` through a
 //! `mask`, lower · (1 − mask) + upper · mask per channel.
 
-use crate::compose::{CHUNK, chunked, grid_mean, resolve};
+use crate::compose::{CHUNK, COMPOSE, Child, GpuCache, chunked, composite_gpu, grid_mean, resolve};
 use radiant_core::glam::Vec2;
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BuildContext, ModuleInfo, ParamDoc, Params, Registry, Rgb, Texture, TextureInput, TextureRef,
+    BuildContext, GpuModule, GpuParams, ModuleInfo, ParamDoc, Params, Registry, Rgb, Texture,
+    TextureInput,
 };
 use serde::Deserialize;
 
 /// Two textures blended by a mask texture.
 pub struct Layered {
-    upper: TextureRef,
-    lower: TextureRef,
-    mask: TextureRef,
+    upper: Child,
+    lower: Child,
+    mask: Child,
     mean: Rgb,
+    gpu: GpuCache,
 }
 
 impl Layered {
-    /// `upper` over `lower` where `mask` is 1.
-    pub fn new(upper: TextureRef, lower: TextureRef, mask: TextureRef) -> Self {
+    /// `upper` over `lower` where `mask` is 1 (each a
+    /// [`TextureRef`](radiant_core::TextureRef) or, for a GPU side with
+    /// varying inputs, a [`Child`] with its id).
+    pub fn new(upper: impl Into<Child>, lower: impl Into<Child>, mask: impl Into<Child>) -> Self {
         let mut t = Self {
-            upper,
-            lower,
-            mask,
+            upper: upper.into(),
+            lower: lower.into(),
+            mask: mask.into(),
             mean: Rgb::ZERO,
+            gpu: GpuCache::default(),
         };
         t.mean = grid_mean(|uv, out| t.eval(uv, out));
         t
@@ -47,6 +52,18 @@ impl Texture for Layered {
 
     fn mean(&self) -> Rgb {
         self.mean
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        self.gpu.get(|| {
+            composite_gpu(
+                "layered",
+                include_str!("layered.wgsl"),
+                &[COMPOSE],
+                GpuParams::new(),
+                &[&self.upper, &self.lower, &self.mask],
+            )
+        })
     }
 }
 

@@ -21,6 +21,7 @@ mod wrap;
 
 pub use bitmap::{Filtering, ImageTexture};
 pub use checkerboard::Checkerboard;
+pub use compose::Child;
 pub use constant::Constant;
 pub use layered::Layered;
 pub use load::{LoadError, Texels, load};

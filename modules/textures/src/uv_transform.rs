@@ -2,12 +2,12 @@
 //! coordinates uv' = R(rotate) · (scale ⊙ uv) + offset — scale first, then
 //! rotate (counter-clockwise, degrees) about the origin, then offset.
 
-use crate::compose::{CHUNK, chunked, grid_mean, resolve};
+use crate::compose::{CHUNK, COMPOSE, Child, GpuCache, chunked, composite_gpu, grid_mean, resolve};
 use radiant_core::glam::{Mat2, Vec2};
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BuildContext, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb, Texture, TextureInput,
-    TextureRef,
+    BuildContext, GpuModule, GpuParams, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb,
+    Texture, TextureInput,
 };
 use serde::Deserialize;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
@@ -15,22 +15,25 @@ use std::fmt;
 
 /// A texture read through an affine map of its coordinates.
 pub struct UvTransform {
-    texture: TextureRef,
+    texture: Child,
     matrix: Mat2,
     offset: Vec2,
     mean: Rgb,
+    gpu: GpuCache,
 }
 
 impl UvTransform {
     /// `texture` scaled by `scale`, rotated by `rotate_degrees` and shifted
-    /// by `offset`.
-    pub fn new(texture: TextureRef, scale: Vec2, rotate_degrees: f32, offset: Vec2) -> Self {
+    /// by `offset` (`texture` a [`TextureRef`](radiant_core::TextureRef)
+    /// or, for a GPU side with a varying input, a [`Child`] with its id).
+    pub fn new(texture: impl Into<Child>, scale: Vec2, rotate_degrees: f32, offset: Vec2) -> Self {
         let matrix = Mat2::from_angle(rotate_degrees.to_radians()) * Mat2::from_diagonal(scale);
         let mut t = Self {
-            texture,
+            texture: texture.into(),
             matrix,
             offset,
             mean: Rgb::ZERO,
+            gpu: GpuCache::default(),
         };
         t.mean = grid_mean(|uv, out| t.eval(uv, out));
         t
@@ -56,6 +59,21 @@ impl Texture for UvTransform {
 
     fn mean(&self) -> Rgb {
         self.mean
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        self.gpu.get(|| {
+            let own = GpuParams::new()
+                .f32s(self.matrix.to_cols_array())
+                .f32s(self.offset.to_array());
+            composite_gpu(
+                "uv_transform",
+                include_str!("uv_transform.wgsl"),
+                &[COMPOSE],
+                own,
+                &[&self.texture],
+            )
+        })
     }
 }
 

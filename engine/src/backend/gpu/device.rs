@@ -13,6 +13,10 @@ pub struct GpuOptions {
     /// The largest storage buffer the frame will need, if known: an
     /// adapter that cannot bind one that large is refused up front.
     pub storage_buffer_bytes: Option<u64>,
+    /// Compile traversal counters into the kernel (nodes visited,
+    /// primitives tested; slower), read with
+    /// [`GpuBackend::last_stats`](super::GpuBackend::last_stats).
+    pub stats: bool,
 }
 
 /// Errors the device reported outside a call (validation, out of memory,

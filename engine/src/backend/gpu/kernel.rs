@@ -21,6 +21,7 @@ use std::fmt::Write;
 
 const GEOMETRY: &str = include_str!("wgsl/geometry.wgsl");
 const PATH: &str = include_str!("wgsl/path.wgsl");
+const HEADER: &str = include_str!("wgsl/header.wgsl");
 
 /// Features that select blocks of the kernel's own sources.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -37,6 +38,8 @@ pub struct Features {
     pub area_lights: bool,
     /// Lights at infinity that escaped rays see.
     pub environment: bool,
+    /// Counting of traversal work (`--gpu-stats`).
+    pub stats: bool,
 }
 
 impl Features {
@@ -49,6 +52,7 @@ impl Features {
             lights: !scene.lights.is_empty(),
             area_lights: modules.area_lights,
             environment: modules.environment,
+            stats: false,
         }
     }
 
@@ -60,6 +64,7 @@ impl Features {
             "LIGHTS" => self.lights,
             "AREA_LIGHTS" => self.area_lights,
             "ENVIRONMENT" => self.environment,
+            "STATS" => self.stats,
             _ => return None,
         })
     }
@@ -125,6 +130,7 @@ impl Kernel {
             parts: Vec::new(),
             features,
         };
+        k.part("the parameter header (wgsl/header.wgsl)", HEADER);
         k.modules(modules);
         k.part("the generated dispatchers", &dispatchers(modules));
         k.part(
@@ -151,9 +157,9 @@ impl Kernel {
             "the probe's bindings",
             "@group(0) @binding(0) var<storage, read> module_params: array<u32>;\n\
              @group(0) @binding(1) var<storage, read> probe_in: array<f32>;\n\
-             @group(0) @binding(2) var<storage, read_write> probe_out: array<f32>;\n\
-             const H_TEXTURES: u32 = 8u;\n",
+             @group(0) @binding(2) var<storage, read_write> probe_out: array<f32>;\n",
         );
+        k.part("the parameter header (wgsl/header.wgsl)", HEADER);
         k.modules(modules);
         k.part("the generated dispatchers", &dispatchers(modules));
         k.part("the probe", body);
@@ -177,9 +183,9 @@ impl Kernel {
              @group(0) @binding(3) var<storage, read> shading: array<vec4f>;\n\
              @group(0) @binding(4) var<storage, read> instances: array<vec4f>;\n\
              @group(0) @binding(5) var<storage, read> rays: array<vec4f>;\n\
-             @group(0) @binding(6) var<storage, read_write> hits: array<vec4f>;\n\
-             const H_ROOT: u32 = 0u;\n",
+             @group(0) @binding(6) var<storage, read_write> hits: array<vec4f>;\n",
         );
+        k.part("the parameter header (wgsl/header.wgsl)", HEADER);
         k.part(
             "the module prelude (radiant-core)",
             radiant_core::gpu::PRELUDE,

@@ -157,6 +157,22 @@ fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     })
 }
 
+/// What the last render counted beyond [`Rendered`]: shadow rays apart,
+/// and with [`GpuOptions::stats`] the traversal work.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct GpuStats {
+    /// Camera paths (one camera ray each).
+    pub camera_rays: u64,
+    /// Continuation rays after the camera rays.
+    pub bounce_rays: u64,
+    /// Shadow rays of next-event estimation.
+    pub shadow_rays: u64,
+    /// BVH nodes visited (both levels; zero without `stats`).
+    pub nodes: u64,
+    /// Primitives tested (zero without `stats`).
+    pub prims: u64,
+}
+
 /// The GPU backend: a device and what it keeps between frames.
 pub struct GpuBackend {
     device: wgpu::Device,
@@ -166,6 +182,8 @@ pub struct GpuBackend {
     pipeline: Option<Pipeline>,
     layout: wgpu::BindGroupLayout,
     errors: device::ErrorSink,
+    stats: bool,
+    last: GpuStats,
 }
 
 /// Uploads `data` (at least 16 bytes, so that empty arrays bind).
@@ -194,6 +212,8 @@ impl GpuBackend {
         let (device, queue, info, limits, errors) = device::open(options)?;
         let layout = bind_group_layout(&device);
         Ok(Self {
+            stats: options.stats,
+            last: GpuStats::default(),
             layout,
             device,
             queue,
@@ -210,6 +230,11 @@ impl GpuBackend {
             "{} ({:?}, {:?})",
             self.info.name, self.info.backend, self.info.device_type
         )
+    }
+
+    /// What the last render counted.
+    pub fn last_stats(&self) -> GpuStats {
+        self.last
     }
 
     /// Whether the adapter is a software rasteriser on the CPU (lavapipe).
@@ -287,7 +312,14 @@ impl GpuBackend {
         scene: &RenderScene,
         progress: &Progress<'_>,
     ) -> Result<Rendered, GpuError> {
-        let plan = Plan::new(scene)?;
+        let mut plan = Plan::new(scene)?;
+        if self.stats {
+            let features = kernel::Features {
+                stats: true,
+                ..plan.kernel.features
+            };
+            plan.kernel = Kernel::assemble(&plan.modules, features);
+        }
         let s = &scene.settings;
         let max_depth = if s.max_depth < 0 {
             UNLIMITED_DEPTH_CAP
@@ -322,7 +354,7 @@ impl GpuBackend {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let counters = storage(d, "counters", &[0u8; 16], true);
+        let counters = storage(d, "counters", &[0u8; 32], true);
         let work = dispatches(w, h, s.spp, layers);
         let mut slots = vec![0u32; work.len() * UNIFORM_STRIDE as usize / 4];
         for (k, job) in work.iter().enumerate() {
@@ -381,7 +413,13 @@ impl GpuBackend {
         let total = pixels as u64 * s.spp as u64;
         let start = Instant::now();
         let mut done = 0u64;
-        let mut counts = [0u64; 2];
+        let mut counts = [0u64; 5];
+        // Traversal counts reach 32 bits sooner than ray counts.
+        let per_submit = if self.stats {
+            PATHS_PER_SUBMIT >> 4
+        } else {
+            PATHS_PER_SUBMIT
+        };
         let mut k = 0;
         while k < work.len() {
             // A run of dispatches of at most PATHS_PER_SUBMIT paths.
@@ -393,7 +431,7 @@ impl GpuBackend {
                 while k < work.len() {
                     let job = work[k];
                     let n = w as u64 * job.rows as u64 * job.samples as u64;
-                    if paths > 0 && paths + n > PATHS_PER_SUBMIT {
+                    if paths > 0 && paths + n > per_submit {
                         break;
                     }
                     pass.set_bind_group(0, &bind, &[(k as u64 * UNIFORM_STRIDE) as u32]);
@@ -407,10 +445,11 @@ impl GpuBackend {
                 }
             }
             self.queue.submit([enc.finish()]);
-            let c = device::read_u32s(d, &self.queue, &counters, 4, &self.errors)?;
-            counts[0] += u64::from(c[0]);
-            counts[1] += u64::from(c[1]);
-            self.queue.write_buffer(&counters, 0, &[0u8; 16]);
+            let c = device::read_u32s(d, &self.queue, &counters, 5, &self.errors)?;
+            for (total, c) in counts.iter_mut().zip(c) {
+                *total += u64::from(c);
+            }
+            self.queue.write_buffer(&counters, 0, &[0u8; 32]);
             done += paths;
             progress.report(done, total);
         }
@@ -422,6 +461,13 @@ impl GpuBackend {
             &self.errors,
         )?;
         let time = start.elapsed();
+        self.last = GpuStats {
+            camera_rays: total,
+            bounce_rays: counts[1].saturating_sub(total),
+            shadow_rays: counts[2],
+            nodes: counts[3],
+            prims: counts[4],
+        };
         let image = (0..pixels)
             .map(|i| {
                 let (mut c, mut wsum) = (Vec3::ZERO, 0.0);
@@ -441,7 +487,7 @@ impl GpuBackend {
             },
             time,
             samples: total,
-            rays: counts[1],
+            rays: counts[1] + counts[2],
             invalid_samples: counts[0],
         })
     }

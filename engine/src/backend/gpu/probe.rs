@@ -75,9 +75,29 @@ impl GpuBackend {
             label: Some("probe"),
             source: wgpu::ShaderSource::Wgsl(kernel.source.as_str().into()),
         });
+        // An explicit layout: a body need not read every binding.
+        let entry = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("probe"),
+            entries: &[entry(0, true), entry(1, true), entry(2, false)],
+        });
+        let pipeline_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("probe"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
         let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("probe"),
-            layout: None,
+            layout: Some(&pipeline_layout),
             module: &module,
             entry_point: Some("probe"),
             compilation_options: Default::default(),
@@ -102,7 +122,7 @@ impl GpuBackend {
         );
         let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("probe"),
-            layout: &pipeline.get_bind_group_layout(0),
+            layout: &layout,
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,

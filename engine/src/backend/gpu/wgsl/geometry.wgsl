@@ -16,6 +16,13 @@ const GAMMA3: f32 = 1.7881397e-7;
 const GAMMA5: f32 = 2.9802326e-7;
 const GAMMA7: f32 = 4.1723263e-7;
 
+//#if STATS
+// Traversal work of this invocation (`--gpu-stats`): nodes visited and
+// primitives tested.
+var<private> stat_nodes: u32 = 0u;
+var<private> stat_prims: u32 = 0u;
+//#endif
+
 struct Hit {
     t: f32,
     slot: u32,
@@ -104,6 +111,9 @@ fn hit_sphere(slot: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>) -> bool {
 //#endif
 
 fn hit_primitive(slot: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>) -> bool {
+//#if STATS
+    stat_prims++;
+//#endif
 //#if SPHERES
     if prim_kind(slot) == 1u {
         return hit_sphere(slot, o, d, best);
@@ -140,6 +150,9 @@ fn trace_blas(root: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>, any: bool
     var node = root;
     var found = false;
     loop {
+//#if STATS
+        stat_nodes++;
+//#endif
         let a_lo = nodes[4u * node];
         let a_hi = nodes[4u * node + 1u];
         let b_lo = nodes[4u * node + 2u];
@@ -235,6 +248,9 @@ fn trace_scene(o: vec3f, d: vec3f, best: ptr<function, Hit>, any: bool) -> bool 
     var node = param_u32(H_ROOT);
     var found = false;
     loop {
+//#if STATS
+        stat_nodes++;
+//#endif
         let a_lo = nodes[4u * node];
         let a_hi = nodes[4u * node + 1u];
         let b_lo = nodes[4u * node + 2u];

@@ -18,21 +18,6 @@ struct FrameUniform {
     pad2: u32,
 }
 
-// The scene header at the start of module_params (upload.rs, Header).
-const H_ROOT: u32 = 0u;
-const H_CAMERA: u32 = 1u;
-const H_SAMPLER: u32 = 2u;
-const H_FILTER: u32 = 3u;
-const H_FILTER_RES: u32 = 4u;
-const H_FILTER_RADIUS: u32 = 5u;
-const H_FILTER_INTEGRAL: u32 = 6u;
-const H_MATERIALS: u32 = 7u;
-const H_TEXTURES: u32 = 8u;
-const H_LIGHTS: u32 = 9u;
-const H_LIGHT_COUNT: u32 = 10u;
-const H_LIGHT_CDF: u32 = 11u;
-const H_ENVIRONMENT: u32 = 12u;
-const H_ENVIRONMENT_COUNT: u32 = 13u;
 
 @group(0) @binding(0) var<uniform> frame: FrameUniform;
 @group(0) @binding(1) var<storage, read> module_params: array<u32>;
@@ -150,8 +135,8 @@ fn sampled_point_error(p: vec3f) -> vec3f {
 }
 
 // Radiance of one camera path, and its filter weight in w; adds the rays
-// it traced to `rays`.
-fn trace_path(px: u32, py: u32, index: u32, rays: ptr<function, u32>) -> vec4f {
+// it traced to `rays` (camera and continuation) and `shadow_rays`.
+fn trace_path(px: u32, py: u32, index: u32, rays: ptr<function, u32>, shadow_rays: ptr<function, u32>) -> vec4f {
     let pixel = py * frame.width + px;
     let fs = filter_sample(sample_2d(pixel, index, 0u));
     let film_pos = vec2f(f32(px), f32(py)) + vec2f(0.5) + fs.xy;
@@ -220,7 +205,7 @@ fn trace_path(px: u32, py: u32, index: u32, rays: ptr<function, u32>) -> vec4f {
                     if any(ls.n != vec3f(0.0)) {
                         target_point = offset_origin(ls.p, sampled_point_error(ls.p), ls.n, -wi_world);
                     }
-                    *rays += 1u;
+                    *shadow_rays += 1u;
                     if !occluded(origin, target_point - origin, 1.0 - SHADOW_EPSILON) {
                         radiance += value;
                     }
@@ -258,9 +243,16 @@ fn trace_path(px: u32, py: u32, index: u32, rays: ptr<function, u32>) -> vec4f {
     return vec4f(radiance, fs.z);
 }
 
-// Rays and invalid samples of the workgroup, added to the counters once.
-var<workgroup> group_rays: atomic<u32>;
+// Counts of the workgroup, added to the counters once: invalid samples,
+// camera and continuation rays, shadow rays (and with STATS, nodes
+// visited and primitives tested).
 var<workgroup> group_invalid: atomic<u32>;
+var<workgroup> group_rays: atomic<u32>;
+var<workgroup> group_shadow: atomic<u32>;
+//#if STATS
+var<workgroup> group_nodes: atomic<u32>;
+var<workgroup> group_prims: atomic<u32>;
+//#endif
 
 // One invocation traces one path: pixel (x, y + pixel_offset), sample
 // first_sample + z, added to film layer z (each invocation of a dispatch
@@ -271,8 +263,9 @@ fn render(@builtin(global_invocation_id) gid: vec3u, @builtin(local_invocation_i
     let py = gid.y + frame.pixel_offset;
     let in_frame = px < frame.width && py < frame.height && gid.z < frame.samples;
     var rays = 0u;
+    var shadow_rays = 0u;
     if in_frame {
-        let r = trace_path(px, py, frame.first_sample + gid.z, &rays);
+        let r = trace_path(px, py, frame.first_sample + gid.z, &rays, &shadow_rays);
         let at = (gid.z * frame.height + py) * frame.width + px;
         if is_finite_vec3(r.xyz) {
             film[at] += vec4f(r.xyz * r.w, r.w);
@@ -281,10 +274,20 @@ fn render(@builtin(global_invocation_id) gid: vec3u, @builtin(local_invocation_i
             atomicAdd(&group_invalid, 1u);
         }
         atomicAdd(&group_rays, rays);
+        atomicAdd(&group_shadow, shadow_rays);
+//#if STATS
+        atomicAdd(&group_nodes, stat_nodes);
+        atomicAdd(&group_prims, stat_prims);
+//#endif
     }
     workgroupBarrier();
     if local == 0u {
         atomicAdd(&counters[0], atomicLoad(&group_invalid));
         atomicAdd(&counters[1], atomicLoad(&group_rays));
+        atomicAdd(&counters[2], atomicLoad(&group_shadow));
+//#if STATS
+        atomicAdd(&counters[3], atomicLoad(&group_nodes));
+        atomicAdd(&counters[4], atomicLoad(&group_prims));
+//#endif
     }
 }
