@@ -1,14 +1,16 @@
 //! The GPU backend renders what the CPU backend renders: the same scenes
 //! through both, compared by channel means and block means.
 //!
-//! Both run the same estimator with the same sampler dimensions and filter
-//! importance sampling, so their sample paths mostly coincide and the
+//! Both run the same estimator with the same sampler dimensions and the
+//! same film (filter splatting, the scenes' default, and once filter
+//! importance sampling), so their sample paths mostly coincide and the
 //! images differ only where float rounding sends a path elsewhere: far
 //! less than the noise, which lets the tolerances catch a 2 % energy
 //! error in one module (each test also checks that it would).
 
 use radiant::extract::Overrides;
 use radiant::film::Image;
+use radiant::settings::FilterSampling;
 use radiant_tests::gpu::render_both;
 use radiant_tests::{Tolerances, check_against};
 
@@ -16,10 +18,22 @@ use radiant_tests::{Tolerances, check_against};
 /// that the GPU image matches the CPU one within `tolerances`, and that a
 /// 2 % scale of the GPU image would not.
 fn agrees(scene: &str, size: u32, spp: u32, tolerances: Tolerances) {
+    agrees_with(scene, size, spp, tolerances, None);
+}
+
+/// [`agrees`] with the film's filter sampling set to `sampling`.
+fn agrees_with(
+    scene: &str,
+    size: u32,
+    spp: u32,
+    tolerances: Tolerances,
+    sampling: Option<FilterSampling>,
+) {
     let overrides = Overrides {
         width: Some(size),
         height: Some(size),
         spp: Some(spp),
+        filter_sampling: sampling,
         ..Overrides::default()
     };
     let (gpu, cpu) = render_both(scene, &overrides);
@@ -51,6 +65,17 @@ const CLOSE: Tolerances = Tolerances {
 #[test]
 fn cornell_box() {
     agrees("scenes/cornell-box.yaml", 48, 64, CLOSE);
+}
+
+#[test]
+fn cornell_box_with_filter_importance_sampling() {
+    agrees_with(
+        "scenes/cornell-box.yaml",
+        48,
+        64,
+        CLOSE,
+        Some(FilterSampling::Importance),
+    );
 }
 
 #[test]

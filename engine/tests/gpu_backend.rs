@@ -27,7 +27,6 @@ fn geometry_scene(instanced: bool) -> RenderScene {
 }
 
 fn geometry_scene_with(pebbles: bool, bricks: bool) -> RenderScene {
-    let instanced = pebbles || bricks;
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let base = std::fs::read_to_string(root.join("scenes/cornell-box.yaml")).unwrap();
     let mesh = root.join("scenes/hard/meshes/degenerate.obj");

@@ -9,7 +9,6 @@ use radiant::backend::cpu::{Progress, render};
 use radiant::backend::gpu::{GpuBackend, GpuOptions};
 use radiant::extract::{Overrides, RenderScene, extract};
 use radiant::film::Image;
-use radiant::settings::FilterSampling;
 use std::sync::{Mutex, MutexGuard, OnceLock};
 
 /// The test binary's GPU backend.
@@ -27,19 +26,15 @@ pub fn backend() -> MutexGuard<'static, GpuBackend> {
     b.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// `scene` (relative to the workspace root) extracted with `overrides`,
-/// the film filtered by importance sampling as the GPU does.
+/// `scene` (relative to the workspace root) extracted with `overrides`.
 pub fn extract_scene(scene: &str, overrides: &Overrides) -> RenderScene {
     let loaded = radiant::scene::load(crate::root().join(scene)).expect("scene loads");
-    let overrides = Overrides {
-        filter_sampling: Some(FilterSampling::Importance),
-        ..*overrides
-    };
-    extract(&loaded, &radiant::builtin_registry(), &overrides).expect("scene extracts")
+    extract(&loaded, &radiant::builtin_registry(), overrides).expect("scene extracts")
 }
 
 /// The GPU's and the CPU's renders of `scene`: the same estimator, sampler
-/// and filter sampling, so the same expectation.
+/// and filter sampling (the scene's, or `overrides.filter_sampling`), so the
+/// same expectation.
 pub fn render_both(scene: &str, overrides: &Overrides) -> (Image, Image) {
     let r = extract_scene(scene, overrides);
     let gpu = backend()

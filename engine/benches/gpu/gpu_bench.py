@@ -6,6 +6,9 @@ Usage (from the repository root):
         --models ../shared/data/models [--peer ../shared/peers/mitsuba_gpu.py] \
         [--cpu] [--spp 16,64,256] [--repeat 3] [--out DIR]
 
+    python3 engine/benches/gpu/gpu_bench.py --radiant target/release/radiant \
+        --models ../shared/data/models --analysis [--peer ...]
+
 Renders cornell.yaml and cornell-bunny.yaml (1024x1024, max_depth 8) with
 `--backend gpu`, once to warm up and then --repeat times, and prints the best
 render time (the CLI's `rendered ... in T s`: kernel time and readback, not
@@ -14,6 +17,14 @@ Mrays/s. With --peer, runs Mitsuba's script in the same run (it needs
 Mitsuba 3 with `cuda_ad_rgb` on PYTHONPATH) and prints the ratio. With
 --cpu, renders the same scenes with `--backend cpu`. Skips, saying why,
 where there is no GPU adapter or no Mitsuba.
+
+--analysis instead explains the GPU time: rays by kind and traversal work
+per ray (`--gpu-stats`), render time against max_depth 1..8 (the
+differences are the cost of each bounce), the large-mesh scenes
+(cornell-ogre.yaml, 124k triangles; cornell-ogres.yaml, 24 instances of it),
+and equal error: the time Radiant needs to reach the mean squared error of
+Mitsuba's 256-spp render, each measured against its own converged reference
+(Radiant 8192 spp, Mitsuba 4096 spp, with --peer).
 """
 import argparse
 import os
@@ -69,6 +80,101 @@ def peer(script, models, out):
     return found
 
 
+def counts(radiant, scene, spp):
+    cmd = [radiant, "render", os.path.join(HERE, scene), "-o", "/tmp/stats.exr", "--spp", str(spp),
+           "--backend", "gpu", "--gpu-stats"]
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    return [l for l in p.stderr.splitlines() if l.startswith("rays:")]
+
+
+def read_exr(path):
+    import mitsuba as mi
+    import numpy as np
+    if mi.variant() is None:
+        mi.set_variant("scalar_rgb" if "scalar_rgb" in mi.variants() else mi.variants()[0])
+    return np.array(mi.Bitmap(path), dtype=np.float64)[:, :, :3]
+
+
+def mse(a, b):
+    return float(((a - b) ** 2).mean())
+
+
+def equal_error(radiant, peer_script, models, out):
+    """Radiant's time to Mitsuba's 256-spp error, each against its own reference."""
+    import mitsuba as mi
+    for name, scene in SCENES:
+        ref = os.path.join(out, f"ref-radiant-{name}.exr")
+        render(radiant, scene, 8192, "gpu", ref)
+        r_ref = read_exr(ref)
+        times = {}
+        errors = {}
+        for spp in [16, 32, 64, 128, 256]:
+            path = os.path.join(out, f"eq-{name}-{spp}.exr")
+            subprocess.run([radiant, "render", os.path.join(HERE, scene), "-o", path, "--spp", str(spp),
+                            "--backend", "gpu", "--seed", "77"], capture_output=True, text=True)
+            best, _ = render(radiant, scene, spp, "gpu", os.path.join(out, "tmp.exr"))
+            times[spp] = best[0]
+            errors[spp] = mse(read_exr(path), r_ref)
+            print(f"radiant {name} spp {spp}: MSE {errors[spp]:.4e} in {times[spp]:.4f}s", flush=True)
+        if not peer_script:
+            continue
+        # Mitsuba: a 4096-spp reference and a 256-spp render, timed.
+        code = f"""
+import sys, time, drjit as dr, mitsuba as mi, numpy as np
+mi.set_variant('cuda_ad_rgb')
+sys.argv = ['x', 'cuda_ad_rgb']
+exec(open({peer_script!r}).read().split('bench("cornell"')[0])
+d = cornell(1024, {os.path.join(models, 'stanford-bunny.obj')!r} if {name!r} == 'bunny' else None)
+scene = mi.load_dict(d)
+ref = np.zeros((1024, 1024, 3))
+for s in range(8):
+    ref += np.array(mi.render(scene, spp=512, seed=100 + s))[:, :, :3] / 8
+np.array(mi.render(scene, spp=256, seed=1)); dr.sync_thread()
+t0 = time.perf_counter(); img = np.array(mi.render(scene, spp=256, seed=2)); dr.sync_thread(); t = time.perf_counter() - t0
+print('MITSUBA', t, float(((img[:, :, :3] - ref) ** 2).mean()))
+"""
+        p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+        line = [l for l in p.stdout.splitlines() if l.startswith("MITSUBA")]
+        if not line:
+            print(f"skip: Mitsuba equal-error run failed: {p.stderr.strip().splitlines()[-3:]}")
+            continue
+        _, t_m, e_m = line[0].split()
+        t_m, e_m = float(t_m), float(e_m)
+        reach = [spp for spp in sorted(errors) if errors[spp] <= e_m]
+        if reach:
+            spp = reach[0]
+            print(f"equal error {name}: Mitsuba 256 spp MSE {e_m:.4e} in {t_m:.4f}s; Radiant reaches it at "
+                  f"{spp} spp in {times[spp]:.4f}s -> {t_m / times[spp]:.2f}x faster at equal error", flush=True)
+        else:
+            print(f"equal error {name}: Mitsuba MSE {e_m:.4e} in {t_m:.4f}s; Radiant at 256 spp {errors[256]:.4e}")
+
+
+def analysis(radiant, peer_script, models, out):
+    scenes = SCENES + [("ogre", "cornell-ogre.yaml"), ("ogres", "cornell-ogres.yaml")]
+    for name, scene in scenes:
+        for line in counts(radiant, scene, 16):
+            print(f"counts {name} 16 spp: {line}", flush=True)
+    for name, scene in scenes[2:]:
+        best, err = render(radiant, scene, 64, "gpu", os.path.join(out, "tmp.exr"))
+        if best:
+            print(f"radiant gpu {name} 1024x1024 spp 64: {best[1]:.1f} Msamples/s, {best[2]:.1f} Mrays/s", flush=True)
+    for name, scene in SCENES:
+        prev = 0.0
+        for depth in range(1, 9):
+            cmd = [radiant, "render", os.path.join(HERE, scene), "-o", os.path.join(out, "tmp.exr"), "--spp", "64",
+                   "--backend", "gpu", "--max-depth", str(depth)]
+            runs = []
+            for _ in range(3):
+                p = subprocess.run(cmd, capture_output=True, text=True)
+                m = LINE.search(p.stderr)
+                if m:
+                    runs.append(float(m.group(4)))
+            t = min(runs)
+            print(f"depth {name} max_depth {depth}: {t:.4f}s (+{t - prev:.4f}s)", flush=True)
+            prev = t
+    equal_error(radiant, peer_script, models, out)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--radiant", default="target/release/radiant")
@@ -78,12 +184,16 @@ def main():
     ap.add_argument("--spp", default="16,64,256")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--out", default=os.environ.get("OUT", "."))
+    ap.add_argument("--analysis", action="store_true", help="explain the time instead (see above)")
     a = ap.parse_args()
     link = os.path.join(HERE, "models")
     if os.path.islink(link):
         os.remove(link)
     if not os.path.exists(link):
         os.symlink(os.path.abspath(a.models), link)
+    if a.analysis:
+        analysis(a.radiant, a.peer, a.models, a.out)
+        return
     spps = [int(s) for s in a.spp.split(",")]
     gpu = bench(a.radiant, "gpu", spps, a.repeat, a.out)
     mitsuba = peer(a.peer, a.models, a.out) if a.peer else {}

@@ -10,12 +10,15 @@
 //! diffuse one by the cosine.
 
 use crate::fresnel::schlick;
+use crate::gpu;
 use crate::half_vector::{HalfVectorLobes, HalfVectorShader, specular_probability};
 use crate::inputs::{checked, fraction, half, scalar};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::cosine_hemisphere_pdf;
-use radiant_core::{BuildContext, ParamDoc, ParamError, Params, Registry, Rgb, TextureInput};
+use radiant_core::{
+    BuildContext, GpuLibrary, ParamDoc, ParamError, Params, Registry, Rgb, TextureInput,
+};
 use serde::Deserialize;
 use std::f32::consts::{FRAC_PI_2, PI};
 
@@ -99,6 +102,9 @@ impl Lobes {
 }
 
 impl HalfVectorLobes for Lobes {
+    const GPU_IDENT: &'static str = "ashikhmin_shirley";
+    const GPU_CODE: &'static [GpuLibrary] = &[gpu::ASHIKHMIN_SHIRLEY];
+
     fn new(rd: Rgb, rs: Rgb, nu: Rgb, nv: Rgb) -> Self {
         Self {
             rd,

@@ -7,16 +7,25 @@
 //! sampling sees the same density as [`Shader::eval`]. A delta sample
 //! keeps its component's weight, which is unbiased for the mix (a delta
 //! lobe of one component is not evaluated through the other).
+//!
+//! On the GPU a blend calls its parts' functions directly: its WGSL is
+//! made from `blend.wgsl` for the pair of part types, and its parameters
+//! hold the parts'. WGSL has no recursion, so the kernel's generic
+//! `bsdf_sample` dispatcher (which dispatches to blends too) cannot be
+//! used; a part's code must be in libraries (as every built-in type's is,
+//! see [`crate::gpu`]) or be a blend's, whose code is included renamed.
 
+use crate::gpu;
 use crate::inputs::{fraction, half, scalar, texture_effects};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry,
-    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, GpuModule, GpuParams, ParamDoc, ParamError,
+    Params, Registry, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 use serde::de::IgnoredAny;
+use std::borrow::Cow;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -212,7 +221,58 @@ impl Shader for Blend {
     fn effects(&self) -> Effects {
         self.effects
     }
+
+    /// Where both parts have a GPU side whose code is in libraries or is
+    /// a blend's (see the module docs).
+    fn gpu(&self) -> Option<GpuModule> {
+        let [a, b] = [self.parts[0].gpu()?, self.parts[1].gpu()?];
+        // Unique per pair of part types (the length makes it decodable),
+        // so that one identifier always means the same code.
+        let ident = format!("{BLEND_PREFIX}{}_{}_{}", a.ident.len(), a.ident, b.ident);
+        let mut wgsl = String::new();
+        let mut libraries = vec![gpu::COMMON];
+        let mut names = Vec::with_capacity(2);
+        for (part, suffix) in [(&a, "__a"), (&b, "__b")] {
+            libraries.extend_from_slice(part.requires);
+            if !part.wgsl.contains("fn ") {
+                names.push(part.ident.to_string());
+            } else if part.ident.starts_with(BLEND_PREFIX) {
+                // Every name in a blend's code contains its identifier:
+                // renamed, a nested blend's code cannot clash with the same
+                // blend's elsewhere in the kernel.
+                let renamed = format!("{ident}{suffix}");
+                wgsl += &part.wgsl.replace(&*part.ident, &renamed);
+                names.push(renamed);
+            } else {
+                return None;
+            }
+        }
+        wgsl += &BLEND_WGSL
+            .split_once("\n\n")
+            .map_or(BLEND_WGSL, |(_header, code)| code)
+            .replace("$SELF", &ident)
+            .replace("$A", &names[0])
+            .replace("$B", &names[1]);
+        let params = GpuParams::new()
+            .texture(self.weight)
+            .u32(2 + a.params.len() as u32)
+            .append(&a.params)
+            .append(&b.params);
+        Some(GpuModule {
+            ident: Cow::Owned(ident),
+            wgsl: Cow::Owned(wgsl),
+            requires: gpu::interned(&libraries),
+            params,
+        })
+    }
 }
+
+/// The start of every blend's GPU identifier.
+const BLEND_PREFIX: &str = "blend_";
+
+/// The template of a blend's WGSL (its header comment, up to the first
+/// blank line, is left out of the code made from it).
+const BLEND_WGSL: &str = include_str!("blend.wgsl");
 
 fn build(params: &Params, ctx: &mut BuildContext<'_>) -> Result<Blend, ParamError> {
     let p: BlendParams = params.parse()?;

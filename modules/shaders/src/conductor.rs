@@ -173,10 +173,7 @@ impl Shader for Conductor {
             .u32(u32::from(self.rough.smooth))
             .texture(self.rough.u)
             .texture(self.rough.v);
-        Some(
-            GpuModule::new("conductor", include_str!("conductor.wgsl"), params)
-                .with_libraries(&[gpu::MICROFACET, gpu::FRESNEL]),
-        )
+        Some(gpu::module("conductor", &[gpu::CONDUCTOR], params))
     }
 }
 

@@ -10,9 +10,7 @@ fn conductor_fresnel(p: u32, cos_i: f32) -> vec3f {
 }
 
 fn conductor_alpha(p: u32, uv: vec2f) -> vec2f {
-    let au = texture_eval(param_u32(p + 9u), uv);
-    let av = texture_eval(param_u32(p + 10u), uv);
-    return ggx_alpha((au.x + au.y + au.z) / 3.0, (av.x + av.y + av.z) / 3.0);
+    return ggx_alpha(texture_scalar(param_u32(p + 9u), uv), texture_scalar(param_u32(p + 10u), uv));
 }
 
 fn bsdf_sample_conductor(p: u32, s: ShadingPoint, u: vec3f) -> BsdfSample {

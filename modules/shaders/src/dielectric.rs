@@ -169,16 +169,15 @@ impl Shader for Dielectric {
         self.effects
     }
 
-    /// Smooth dielectrics only, so far: a rough one has no GPU side.
     fn gpu(&self) -> Option<GpuModule> {
-        self.rough.smooth.then(|| {
-            let params = GpuParams::new()
-                .f32(self.eta)
-                .texture(self.reflectance)
-                .texture(self.transmittance);
-            GpuModule::new("dielectric", include_str!("dielectric.wgsl"), params)
-                .with_libraries(&[gpu::FRESNEL])
-        })
+        let params = GpuParams::new()
+            .f32(self.eta)
+            .texture(self.reflectance)
+            .texture(self.transmittance)
+            .u32(u32::from(self.rough.smooth))
+            .texture(self.rough.u)
+            .texture(self.rough.v);
+        Some(gpu::module("dielectric", &[gpu::DIELECTRIC], params))
     }
 }
 

@@ -1,5 +1,6 @@
 //! The `diffuse` shader: an ideal one-sided Lambertian reflector.
 
+use crate::gpu;
 use crate::inputs::{fraction, half};
 use crate::lobes::reflection_sample;
 use radiant_core::glam::{Vec2, Vec3};
@@ -89,9 +90,9 @@ impl Shader for Diffuse {
     }
 
     fn gpu(&self) -> Option<GpuModule> {
-        Some(GpuModule::new(
+        Some(gpu::module(
             "diffuse",
-            include_str!("diffuse.wgsl"),
+            &[gpu::DIFFUSE],
             GpuParams::new().texture(self.reflectance),
         ))
     }

@@ -9,13 +9,20 @@ use crate::lobes::reflection_sample;
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::warp::square_to_cosine_hemisphere;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, Rgb, ShadeContext, Shader, SurfaceBatch,
-    TextureId, luminance,
+    BsdfEval, BsdfSample, BuildContext, Effects, GpuLibrary, GpuModule, GpuParams, Rgb,
+    ShadeContext, Shader, SurfaceBatch, TextureId, luminance,
 };
 use std::marker::PhantomData;
 
 /// The lobes of one model at one surface point.
 pub(crate) trait HalfVectorLobes {
+    /// The model's shader type identifier on the GPU.
+    const GPU_IDENT: &'static str;
+
+    /// The library holding the model's WGSL (see [`crate::gpu`]), which
+    /// reads the four textures in the shader's order.
+    const GPU_CODE: &'static [GpuLibrary];
+
     /// The lobes from the texture values at the point: diffuse and specular
     /// reflectance and the two roughness parameters.
     fn new(diffuse: Rgb, specular: Rgb, u: Rgb, v: Rgb) -> Self;
@@ -107,5 +114,13 @@ impl<L: HalfVectorLobes> Shader for HalfVectorShader<L> {
 
     fn effects(&self) -> Effects {
         self.effects
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let params = self
+            .textures
+            .iter()
+            .fold(GpuParams::new(), |p, &t| p.texture(t));
+        Some(crate::gpu::module(L::GPU_IDENT, L::GPU_CODE, params))
     }
 }

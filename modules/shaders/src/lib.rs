@@ -11,6 +11,10 @@
 //! `normal_map` and `bump`), `inputs` (parameter helpers) and `metals`
 //! (complex indices of refraction).
 //!
+//! GPU sides: each type's WGSL is `src/<type>.wgsl`, included in a kernel
+//! as a library of that type's (`gpu`), so that `blend` can call any type;
+//! `normal_map` and `bump` have none yet (they need tangent frames).
+//!
 //! Emissive surfaces are not a shader: they are declared with an `emitter`
 //! (the `area` light) on the shape, so that next-event estimation can
 //! sample them and multiple importance sampling can weight their hits;

@@ -7,6 +7,7 @@
 //! transmittance.
 
 use crate::fresnel;
+use crate::gpu;
 use crate::inputs::{Ior, fraction, half, one, relative_ior, scalar, texture_effects};
 use crate::lobes::{glossy_eval, glossy_sample, mirror_sample, reflection_sample};
 use crate::microfacet::{Ggx, reflect, refract};
@@ -14,8 +15,8 @@ use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
-    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, GpuModule, GpuParams, ParamDoc, ParamError,
+    Params, Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 use std::f32::consts::FRAC_1_PI;
@@ -201,6 +202,20 @@ impl Shader for Plastic {
 
     fn effects(&self) -> Effects {
         self.effects
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let params = GpuParams::new()
+            .f32(self.eta)
+            .u32(u32::from(self.ggx.is_some()))
+            .f32(self.ggx.map_or(0.0, |g| g.alpha_u))
+            .texture(self.diffuse)
+            .texture(self.specular)
+            .u32(u32::from(self.nonlinear))
+            .f32(self.internal)
+            .f32(self.specular_weight)
+            .f32s(self.transmittance);
+        Some(gpu::module("plastic", &[gpu::PLASTIC], params))
     }
 }
 

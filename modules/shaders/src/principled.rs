@@ -18,6 +18,7 @@
 //! an albedo estimate, and the returned density is that of the whole mix.
 
 use crate::fresnel::schlick;
+use crate::gpu;
 use crate::inputs::{fraction, half, scalar, texture_effects, zero};
 use crate::lobes::{glossy_eval, glossy_sample, interface_eval, interface_sample};
 use crate::microfacet::Ggx;
@@ -25,8 +26,8 @@ use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
-    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput, luminance,
+    BsdfEval, BsdfSample, BuildContext, Effects, GpuModule, GpuParams, ParamDoc, ParamError,
+    Params, Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput, luminance,
 };
 use serde::Deserialize;
 use std::f32::consts::PI;
@@ -260,6 +261,16 @@ impl Shader for Principled {
 
     fn effects(&self) -> Effects {
         self.effects
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let params = GpuParams::new()
+            .texture(self.base)
+            .texture(self.metallic)
+            .texture(self.roughness)
+            .texture(self.specular)
+            .texture(self.transmission);
+        Some(gpu::module("principled", &[gpu::PRINCIPLED], params))
     }
 }
 

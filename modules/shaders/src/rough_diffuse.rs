@@ -3,14 +3,15 @@
 //! as in Mitsuba 3's `roughdiffuse` (after Oren and Nayar 1994); sampled by
 //! the cosine-weighted hemisphere.
 
+use crate::gpu;
 use crate::inputs::{fraction, half, scalar, texture_effects};
 use crate::lobes::reflection_sample;
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry, Rgb,
-    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, GpuModule, GpuParams, ParamDoc, ParamError,
+    Params, Registry, Rgb, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 use std::f32::consts::{FRAC_1_PI, SQRT_2};
@@ -140,6 +141,13 @@ impl Shader for RoughDiffuse {
 
     fn effects(&self) -> Effects {
         self.effects
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let params = GpuParams::new()
+            .texture(self.reflectance)
+            .texture(self.alpha);
+        Some(gpu::module("rough_diffuse", &[gpu::ROUGH_DIFFUSE], params))
     }
 }
 

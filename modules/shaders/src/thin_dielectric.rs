@@ -5,13 +5,14 @@
 
 use crate::dielectric::{EXT_IOR_DOC, INT_IOR_DOC};
 use crate::fresnel;
+use crate::gpu;
 use crate::inputs::{BK7, Ior, fraction, one, relative_ior, texture_effects};
 use crate::lobes::mirror_sample;
 use radiant_core::glam::Vec3;
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ParamDoc, ParamError, Params, Registry,
-    ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
+    BsdfEval, BsdfSample, BuildContext, Effects, GpuModule, GpuParams, ParamDoc, ParamError,
+    Params, Registry, ShadeContext, Shader, SurfaceBatch, TextureId, TextureInput,
 };
 use serde::Deserialize;
 
@@ -103,6 +104,18 @@ impl Shader for ThinDielectric {
 
     fn effects(&self) -> Effects {
         self.effects
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let params = GpuParams::new()
+            .f32(self.eta)
+            .texture(self.reflectance)
+            .texture(self.transmittance);
+        Some(gpu::module(
+            "thin_dielectric",
+            &[gpu::THIN_DIELECTRIC],
+            params,
+        ))
     }
 }
 

@@ -5,12 +5,15 @@
 //!
 //! f = ρd/π + ρs · exp(−tan²θh (cos²φh/αu² + sin²φh/αv²)) / (4π αu αv (wi·h)² cos⁴θh).
 
+use crate::gpu;
 use crate::half_vector::{HalfVectorLobes, HalfVectorShader, specular_probability};
 use crate::inputs::{checked, fraction, half, scalar};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::warp::cosine_hemisphere_pdf;
-use radiant_core::{BuildContext, ParamDoc, ParamError, Params, Registry, Rgb, TextureInput};
+use radiant_core::{
+    BuildContext, GpuLibrary, ParamDoc, ParamError, Params, Registry, Rgb, TextureInput,
+};
 use serde::Deserialize;
 use std::f32::consts::{FRAC_1_PI, PI};
 
@@ -86,6 +89,9 @@ impl Lobes {
 }
 
 impl HalfVectorLobes for Lobes {
+    const GPU_IDENT: &'static str = "ward";
+    const GPU_CODE: &'static [GpuLibrary] = &[gpu::WARD];
+
     fn new(rd: Rgb, rs: Rgb, au: Rgb, av: Rgb) -> Self {
         Self {
             rd,

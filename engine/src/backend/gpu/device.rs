@@ -56,7 +56,7 @@ fn limits_for(adapter: &wgpu::Adapter, options: &GpuOptions) -> Result<wgpu::Lim
     let checks = [
         (
             "max_storage_buffers_per_shader_stage",
-            7,
+            8,
             u64::from(limits.max_storage_buffers_per_shader_stage),
         ),
         (

@@ -40,6 +40,10 @@ pub struct Features {
     pub environment: bool,
     /// Counting of traversal work (`--gpu-stats`).
     pub stats: bool,
+    /// Samples splatted over the pixels in the filter's reach (the film's
+    /// default, as the CPU and Mitsuba do) rather than placed by filter
+    /// importance sampling.
+    pub splat: bool,
 }
 
 impl Features {
@@ -53,6 +57,7 @@ impl Features {
             area_lights: modules.area_lights,
             environment: modules.environment,
             stats: false,
+            splat: scene.settings.filter_sampling == crate::settings::FilterSampling::Splat,
         }
     }
 
@@ -65,6 +70,7 @@ impl Features {
             "AREA_LIGHTS" => self.area_lights,
             "ENVIRONMENT" => self.environment,
             "STATS" => self.stats,
+            "SPLAT" => self.splat,
             _ => return None,
         })
     }
@@ -78,6 +84,7 @@ impl Features {
             ("next-event estimation", self.lights),
             ("area lights", self.area_lights),
             ("environment", self.environment),
+            ("filter splatting", self.splat),
         ]
         .into_iter()
         .filter_map(|(n, on)| on.then_some(n))

@@ -116,10 +116,12 @@ struct Pipeline {
     source: String,
     overrides: (u32, u32),
     pipeline: wgpu::ComputePipeline,
+    /// The gather pass of filter splatting, where the kernel splats.
+    gather: Option<wgpu::ComputePipeline>,
 }
 
 /// The kernel's bindings (`wgsl/path.wgsl`): the dispatch's uniform, five
-/// read-only storage buffers, the film and the counters.
+/// read-only storage buffers, the film, the counters and the splats.
 fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
         binding,
@@ -153,6 +155,7 @@ fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             entry(5, read),
             entry(6, write),
             entry(7, write),
+            entry(8, write),
         ],
     })
 }
@@ -262,30 +265,35 @@ impl GpuBackend {
             ("MAX_DEPTH", overrides.0 as f64),
             ("RR_DEPTH", overrides.1 as f64),
         ];
-        let pipeline = self
+        let layout = self
             .device
-            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("radiant path kernel"),
-                layout: Some(&self.device.create_pipeline_layout(
-                    &wgpu::PipelineLayoutDescriptor {
-                        label: Some("radiant path kernel"),
-                        bind_group_layouts: &[Some(&self.layout)],
-                        immediate_size: 0,
-                    },
-                )),
-                module: &module,
-                entry_point: Some("render"),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    ..Default::default()
-                },
-                cache: None,
+                bind_group_layouts: &[Some(&self.layout)],
+                immediate_size: 0,
             });
+        let entry = |name: &str| {
+            self.device
+                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(name),
+                    layout: Some(&layout),
+                    module: &module,
+                    entry_point: Some(name),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        ..Default::default()
+                    },
+                    cache: None,
+                })
+        };
+        let pipeline = entry("render");
+        let gather = kernel.features.splat.then(|| entry("gather"));
         self.errors.check()?;
         self.pipeline = Some(Pipeline {
             source: kernel.source.clone(),
             overrides,
             pipeline,
+            gather,
         });
         Ok(())
     }
@@ -330,7 +338,18 @@ impl GpuBackend {
         let (w, h) = (s.width, s.height);
         let pixels = w as usize * h as usize;
         let layers = ((1u64 << 20) / pixels as u64).clamp(1, MAX_LAYERS.min(s.spp) as u64) as u32;
-        let film_bytes = pixels * layers as usize * 16;
+        // Splatting: one film layer, and the dispatch's samples in layers
+        // for the gather pass; importance sampling: the samples go into
+        // film layers directly.
+        let splat = plan.kernel.features.splat;
+        let film_layers = if splat { 1 } else { layers as usize };
+        let film_bytes = pixels * film_layers * 16;
+        let splat_bytes = if splat {
+            pixels * layers as usize * 16
+        } else {
+            16
+        };
+        self.fits("the splatted samples", splat_bytes)?;
         let g = &plan.geometry;
         self.fits("the film", film_bytes)?;
         self.fits("the BVH nodes", g.nodes.len() * 64)?;
@@ -355,18 +374,35 @@ impl GpuBackend {
             mapped_at_creation: false,
         });
         let counters = storage(d, "counters", &[0u8; 32], true);
+        let splats = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("splats"),
+            size: splat_bytes as u64,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let reach = plan.modules.params[16];
         let work = dispatches(w, h, s.spp, layers);
         let mut slots = vec![0u32; work.len() * UNIFORM_STRIDE as usize / 4];
         for (k, job) in work.iter().enumerate() {
             let at = k * UNIFORM_STRIDE as usize / 4;
-            slots[at..at + 5].copy_from_slice(&[w, h, job.first, job.samples, job.y0]);
+            let gather_y0 = job.y0.saturating_sub(reach);
+            slots[at..at + 7].copy_from_slice(&[
+                w,
+                h,
+                job.first,
+                job.samples,
+                job.y0,
+                job.rows,
+                gather_y0,
+            ]);
         }
         let uniform = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("dispatches"),
             contents: bytemuck::cast_slice(&slots),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let pipeline = &self.pipeline.as_ref().expect("compiled above").pipeline;
+        let compiled = self.pipeline.as_ref().expect("compiled above");
+        let (pipeline, gather) = (&compiled.pipeline, compiled.gather.as_ref());
         let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("frame"),
             layout: &self.layout,
@@ -407,6 +443,10 @@ impl GpuBackend {
                     binding: 7,
                     resource: counters.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 8,
+                    resource: splats.as_entire_binding(),
+                },
             ],
         });
         self.errors.check()?;
@@ -427,19 +467,30 @@ impl GpuBackend {
             let mut paths = 0u64;
             {
                 let mut pass = enc.begin_compute_pass(&Default::default());
-                pass.set_pipeline(pipeline);
                 while k < work.len() {
                     let job = work[k];
                     let n = w as u64 * job.rows as u64 * job.samples as u64;
                     if paths > 0 && paths + n > per_submit {
                         break;
                     }
+                    pass.set_pipeline(pipeline);
                     pass.set_bind_group(0, &bind, &[(k as u64 * UNIFORM_STRIDE) as u32]);
                     pass.dispatch_workgroups(
                         w.div_ceil(WORKGROUP),
                         job.rows.div_ceil(WORKGROUP),
                         job.samples,
                     );
+                    if let Some(gather) = gather {
+                        // The band's rows and the filter's reach around them.
+                        let top = job.y0.saturating_sub(reach);
+                        let bottom = (job.y0 + job.rows + reach).min(h);
+                        pass.set_pipeline(gather);
+                        pass.dispatch_workgroups(
+                            w.div_ceil(WORKGROUP),
+                            (bottom - top).div_ceil(WORKGROUP),
+                            1,
+                        );
+                    }
                     paths += n;
                     k += 1;
                 }
@@ -457,7 +508,7 @@ impl GpuBackend {
             d,
             &self.queue,
             &film,
-            pixels * layers as usize * 4,
+            pixels * film_layers * 4,
             &self.errors,
         )?;
         let time = start.elapsed();

@@ -16,7 +16,7 @@ const FILTER_RES: u32 = 64;
 
 /// Words of the header at the start of the parameter buffer (the `H_*`
 /// constants of `wgsl/path.wgsl`).
-const HEADER_WORDS: usize = 14;
+const HEADER_WORDS: usize = 17;
 
 /// One module type of a kind, as the kernel includes it.
 #[derive(Debug, Clone, PartialEq)]
@@ -114,6 +114,7 @@ impl Modules {
         m.sampler.tag(&sampler);
         m.params[2] = m.push(&sampler);
         m.filter_table(scene.filter.as_ref());
+        m.splat_table(scene.filter.as_ref());
         m.materials(scene)?;
         m.textures(&scene.textures)?;
         m.lights(scene)?;
@@ -172,6 +173,25 @@ impl Modules {
         self.params[5] = radius.to_bits();
         self.params[6] = integral.to_bits();
         self.params.extend(table.iter().map(|v| v.to_bits()));
+    }
+
+    /// The filter tabulated for splatting as the CPU's
+    /// [`FilterTable`](crate::film::FilterTable) tabulates it: 64×64 values
+    /// at cell centres over the quadrant [0, r]² (header words 14–16: where,
+    /// cells per pixel, reach in pixels).
+    fn splat_table(&mut self, filter: &dyn Filter) {
+        let res = 64usize;
+        let radius = filter.radius();
+        let step = radius / res as f32;
+        self.params[14] = self.params.len() as u32;
+        self.params[15] = (res as f32 / radius).to_bits();
+        self.params[16] = (radius + 0.5).ceil() as u32;
+        for y in 0..res {
+            for x in 0..res {
+                let v = filter.eval((x as f32 + 0.5) * step, (y as f32 + 0.5) * step);
+                self.params.push(v.to_bits());
+            }
+        }
     }
 
     /// The materials' directory: (type, offset, flags, 0) per material;

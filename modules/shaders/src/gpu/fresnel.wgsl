@@ -1,4 +1,5 @@
-// Fresnel reflectance, as fresnel.rs (in single precision throughout).
+// Fresnel reflectance, as fresnel.rs (in single precision throughout):
+// dielectric, conductor and Schlick.
 
 // Unpolarised reflectance of a conductor of relative index eta + i k.
 fn fresnel_conductor(cos_i: f32, eta: vec3f, k: vec3f) -> vec3f {
@@ -51,4 +52,11 @@ fn fresnel_dielectric(cos_i: f32, eta: f32) -> DielectricFresnel {
         }
     }
     return DielectricFresnel(r, select(ct, -ct, cos_i >= 0.0), eta_it, eta_ti);
+}
+
+// Schlick's approximation R0 + (1 − R0)(1 − cos)^5, per channel.
+fn fresnel_schlick(cos_i: f32, r0: vec3f) -> vec3f {
+    let m = clamp(1.0 - abs(cos_i), 0.0, 1.0);
+    let m2 = m * m;
+    return r0 + (vec3f(1.0) - r0) * (m2 * m2 * m);
 }

@@ -14,3 +14,6 @@ const H_LIGHT_COUNT: u32 = 10u;
 const H_LIGHT_CDF: u32 = 11u;
 const H_ENVIRONMENT: u32 = 12u;
 const H_ENVIRONMENT_COUNT: u32 = 13u;
+const H_SPLAT: u32 = 14u;
+const H_SPLAT_SCALE: u32 = 15u;
+const H_SPLAT_REACH: u32 = 16u;

@@ -6,16 +6,17 @@
 // to its pixel (filter importance sampling: w = f/pdf).
 
 // What one dispatch renders: samples [first_sample, first_sample +
-// samples) of the rows from pixel_offset on.
+// samples) of rows [pixel_offset, pixel_offset + rows); the gather that
+// follows it (filter splatting) starts at row gather_offset.
 struct FrameUniform {
     width: u32,
     height: u32,
     first_sample: u32,
     samples: u32,
     pixel_offset: u32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
+    rows: u32,
+    gather_offset: u32,
+    pad: u32,
 }
 
 
@@ -27,6 +28,11 @@ struct FrameUniform {
 @group(0) @binding(5) var<storage, read> instances: array<vec4f>;
 @group(0) @binding(6) var<storage, read_write> film: array<vec4f>;
 @group(0) @binding(7) var<storage, read_write> counters: array<atomic<u32>>;
+//#if SPLAT
+// Each path's radiance and its position in its pixel (two unorm16 in w),
+// per layer, for the gather pass.
+@group(0) @binding(8) var<storage, read_write> splats: array<vec4f>;
+//#endif
 
 // Longest path in segments (16384 for unlimited), and the depth from
 // which Russian roulette applies.
@@ -134,12 +140,20 @@ fn sampled_point_error(p: vec3f) -> vec3f {
     return abs(p) * GAMMA7;
 }
 
-// Radiance of one camera path, and its filter weight in w; adds the rays
+// Radiance of one camera path, and its filter weight in w (splatting: its
+// position in the pixel, packed); adds the rays
 // it traced to `rays` (camera and continuation) and `shadow_rays`.
 fn trace_path(px: u32, py: u32, index: u32, rays: ptr<function, u32>, shadow_rays: ptr<function, u32>) -> vec4f {
     let pixel = py * frame.width + px;
+//#if SPLAT
+    // Uniform in the pixel; the gather pass weights it by the filter.
+    let in_pixel = sample_2d(pixel, index, 0u);
+    let film_pos = vec2f(f32(px), f32(py)) + in_pixel;
+    let fs = vec3f(0.0, 0.0, bitcast<f32>(pack2x16unorm(in_pixel)));
+//#else
     let fs = filter_sample(sample_2d(pixel, index, 0u));
     let film_pos = vec2f(f32(px), f32(py)) + vec2f(0.5) + fs.xy;
+//#endif
     let ray = camera_ray(film_pos, sample_2d(pixel, index, 2u));
     var o = ray.origin;
     var d = ray.dir;
@@ -267,12 +281,19 @@ fn render(@builtin(global_invocation_id) gid: vec3u, @builtin(local_invocation_i
     if in_frame {
         let r = trace_path(px, py, frame.first_sample + gid.z, &rays, &shadow_rays);
         let at = (gid.z * frame.height + py) * frame.width + px;
-        if is_finite_vec3(r.xyz) {
+        let finite = is_finite_vec3(r.xyz);
+        if !finite {
+            atomicAdd(&group_invalid, 1u);
+        }
+//#if SPLAT
+        splats[at] = vec4f(select(vec3f(0.0), r.xyz, finite), r.w);
+//#else
+        if finite {
             film[at] += vec4f(r.xyz * r.w, r.w);
         } else {
             film[at].w += r.w;
-            atomicAdd(&group_invalid, 1u);
         }
+//#endif
         atomicAdd(&group_rays, rays);
         atomicAdd(&group_shadow, shadow_rays);
 //#if STATS
@@ -291,3 +312,49 @@ fn render(@builtin(global_invocation_id) gid: vec3u, @builtin(local_invocation_i
 //#endif
     }
 }
+
+//#if SPLAT
+// The filter's weight at offset d from a pixel centre (the CPU's
+// FilterTable: a 64×64 table over the quadrant [0, r]²).
+fn splat_weight(d: vec2f) -> f32 {
+    let cell = abs(d) * param_f32(H_SPLAT_SCALE);
+    if cell.x >= 64.0 || cell.y >= 64.0 {
+        return 0.0;
+    }
+    let c = vec2u(cell);
+    return param_f32(param_u32(H_SPLAT) + c.y * 64u + c.x);
+}
+
+// The gather pass of filter splatting: each invocation owns one pixel and
+// adds the dispatch's samples from the pixels in the filter's reach (rows
+// of the dispatch's band only), weighted by the filter, to it.
+@compute @workgroup_size(8, 8, 1)
+fn gather(@builtin(global_invocation_id) gid: vec3u) {
+    let x = i32(gid.x);
+    let y = i32(gid.y + frame.gather_offset);
+    let w = i32(frame.width);
+    let h = i32(frame.height);
+    if x >= w || y >= h {
+        return;
+    }
+    let reach = i32(param_u32(H_SPLAT_REACH));
+    let y0 = max(y - reach, i32(frame.pixel_offset));
+    let y1 = min(y + reach, i32(frame.pixel_offset + frame.rows) - 1);
+    let x0 = max(x - reach, 0);
+    let x1 = min(x + reach, w - 1);
+    let centre = vec2f(f32(x), f32(y)) + vec2f(0.5);
+    var sum = vec4f(0.0);
+    for (var z = 0u; z < frame.samples; z++) {
+        for (var sy = y0; sy <= y1; sy++) {
+            let row = (i32(z) * h + sy) * w;
+            for (var sx = x0; sx <= x1; sx++) {
+                let s = splats[row + sx];
+                let p = vec2f(f32(sx), f32(sy)) + unpack2x16unorm(bitcast<u32>(s.w));
+                let wt = splat_weight(p - centre);
+                sum += vec4f(s.xyz * wt, wt);
+            }
+        }
+    }
+    film[y * w + x] += sum;
+}
+//#endif
