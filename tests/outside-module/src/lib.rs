@@ -9,10 +9,14 @@
 //! radiant_example_module::register(&mut registry);
 //! ```
 //!
-//! and scenes can then say `type: stripes`.
+//! and scenes can then say `type: stripes`. The texture also has a GPU
+//! side (`Texture::gpu`): its WGSL, `stripes.wgsl`, and its parameters
+//! packed as words, so scenes that use it render with `--backend gpu` too.
 
 use radiant::core::glam::Vec2;
-use radiant::core::{Color, Effects, ModuleInfo, ParamDoc, Params, Registry, Rgb, Texture};
+use radiant::core::{
+    Color, Effects, GpuModule, GpuParams, ModuleInfo, ParamDoc, Params, Registry, Rgb, Texture,
+};
 use serde::Deserialize;
 
 /// Alternating stripes along the surface's u coordinate.
@@ -41,6 +45,16 @@ impl Texture for Stripes {
 
     fn effects(&self) -> Effects {
         Effects::TEXTURES
+    }
+
+    /// `texture_stripes` in `stripes.wgsl`, reading a, b and count.
+    fn gpu(&self) -> Option<GpuModule> {
+        let params = GpuParams::new().rgb(self.a).rgb(self.b).f32(self.count);
+        Some(GpuModule::new(
+            "stripes",
+            include_str!("stripes.wgsl"),
+            params,
+        ))
     }
 }
 

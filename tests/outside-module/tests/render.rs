@@ -1,4 +1,8 @@
-//! The outside module builds, registers and renders like a built-in one.
+//! The outside module builds, registers and renders like a built-in one,
+//! on the CPU and, through its own WGSL, on the GPU.
+
+// `unwrap` in this test code is the assertion: the scene is the test's own,
+// so a failure is a bug, and the panic reports it with the error.
 
 use radiant::backend::cpu::{Progress, render};
 use radiant::extract::{Overrides, extract};
@@ -36,6 +40,28 @@ fn outside_texture_renders() {
     };
     let (left, right) = (column(12), column(19));
     assert!(left > 5.0 * right, "left {left}, right {right}");
+}
+
+#[test]
+fn outside_texture_renders_on_the_gpu_with_its_own_wgsl() {
+    let mut registry = radiant::builtin_registry();
+    radiant_example_module::register(&mut registry);
+    let scene = radiant::scene::from_str(SCENE, Path::new("inline.yaml"), Path::new(".")).unwrap();
+    let r = extract(&scene, &registry, &Overrides::default()).unwrap();
+    let plan = radiant::backend::gpu::Plan::new(&r).unwrap();
+    assert!(plan.kernel.source.contains("fn texture_stripes("));
+    // `expect` in this test code is the assertion: CI provides an adapter
+    // (lavapipe), so one must be found.
+    let mut gpu = radiant::backend::gpu::GpuBackend::new(&Default::default())
+        .expect("a GPU adapter (lavapipe in CI)");
+    let image = gpu.render(&r, &Progress::none()).unwrap().image;
+    let cpu = render(&r, &Progress::none()).image;
+    for (g, c) in image.pixels.iter().zip(&cpu.pixels) {
+        assert!(
+            (*g - *c).abs().max_element() <= 1e-3 * c.max_element().max(1.0),
+            "{g} against {c}"
+        );
+    }
 }
 
 #[test]
