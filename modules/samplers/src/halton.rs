@@ -10,10 +10,10 @@
 //! decorrelates pixels and dimensions.
 
 use crate::pointwise::{Pointwise, pointwise_sampler};
-use crate::scramble::permute;
+use crate::scramble::{SCRAMBLE_WGSL, permute};
 use crate::seed::fold;
 use radiant_core::hash::{hash_u32, hash4};
-use radiant_core::{Registry, SampleId};
+use radiant_core::{GpuModule, GpuParams, Registry, SampleId};
 
 /// Number of distinct prime bases.
 const BASES: usize = 128;
@@ -62,6 +62,16 @@ impl Pointwise for Halton {
         let base = PRIMES[dim as usize % BASES];
         let key = hash4(self.seed, id.pixel, dim, 0x6a09_e667);
         owen_radical_inverse(id.index, base, key)
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let params = PRIMES
+            .iter()
+            .fold(GpuParams::new().u32(self.seed), |p, &b| p.u32(b));
+        Some(
+            GpuModule::new("halton", include_str!("halton.wgsl"), params)
+                .with_libraries(&[SCRAMBLE_WGSL]),
+        )
     }
 }
 

@@ -7,6 +7,16 @@
 //!   fixed-point value with the Laine–Karras hash (Burley 2020, "Practical
 //!   Hash-based Owen Scrambling").
 
+use radiant_core::GpuLibrary;
+
+/// The WGSL of [`permute`] (`smp_permute`) and [`nested_uniform_scramble`]
+/// (`smp_owen_scramble`), for the samplers' GPU sides.
+pub(crate) const SCRAMBLE_WGSL: GpuLibrary = GpuLibrary {
+    name: "samplers::scramble",
+    wgsl: include_str!("scramble.wgsl"),
+    requires: &[],
+};
+
 /// The element at position `i` of a random permutation of 0..`n` chosen by
 /// `key`. Every key gives a bijection of 0..n.
 #[inline]

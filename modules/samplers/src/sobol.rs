@@ -12,11 +12,11 @@
 //! two are best.
 
 use crate::pointwise::{Pointwise, pointwise_sampler};
-use crate::scramble::nested_uniform_scramble;
+use crate::scramble::{SCRAMBLE_WGSL, nested_uniform_scramble};
 use crate::seed::fold;
 use radiant_core::glam::Vec2;
 use radiant_core::hash::{hash_u32, hash4, unit_float};
-use radiant_core::{Registry, SampleId};
+use radiant_core::{GpuModule, GpuParams, Registry, SampleId};
 
 /// Direction numbers of the second Sobol dimension: v₀ = 2³¹,
 /// vᵢ = vᵢ₋₁ ⊕ (vᵢ₋₁ ≫ 1) (the first dimension is the bit reversal).
@@ -76,6 +76,17 @@ impl Pointwise for Sobol {
         let key = hash4(self.seed, id.pixel, dim, 0xa54f_f53a);
         let i = nested_uniform_scramble(id.index, key);
         unit_float(nested_uniform_scramble(i.reverse_bits(), hash_u32(key)))
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        Some(
+            GpuModule::new(
+                "sobol",
+                include_str!("sobol.wgsl"),
+                GpuParams::new().u32(self.seed),
+            )
+            .with_libraries(&[SCRAMBLE_WGSL]),
+        )
     }
 }
 

@@ -11,11 +11,11 @@
 //! beyond N start a fresh, independently shuffled pattern.
 
 use crate::pointwise::{Pointwise, pointwise_sampler};
-use crate::scramble::permute;
+use crate::scramble::{SCRAMBLE_WGSL, permute};
 use crate::seed::fold;
 use radiant_core::glam::Vec2;
 use radiant_core::hash::{hash_u32, hash4, unit_float};
-use radiant_core::{Registry, SampleId};
+use radiant_core::{GpuModule, GpuParams, Registry, SampleId};
 
 /// Jittered stratified sampling over `spp` samples per pixel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -79,6 +79,17 @@ impl Pointwise for Stratified {
         let x = (col as f32 + (sx as f32 + jx) / n as f32) / m as f32;
         let y = (row as f32 + (sy as f32 + jy) / m as f32) / n as f32;
         Vec2::new(x.min(ONE_MINUS_EPSILON), y.min(ONE_MINUS_EPSILON))
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        Some(
+            GpuModule::new(
+                "stratified",
+                include_str!("stratified.wgsl"),
+                GpuParams::new().u32(self.seed).u32(self.spp),
+            )
+            .with_libraries(&[SCRAMBLE_WGSL]),
+        )
     }
 }
 

@@ -158,7 +158,7 @@ pub(super) fn validate(kernel: &Kernel) -> Result<(), GpuError> {
 }
 
 /// Copies the first `count` words of `buffer` back.
-fn read_words(
+pub(super) fn read_words(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     buffer: &wgpu::Buffer,
@@ -192,17 +192,6 @@ fn read_words(
         .map_err(|e| GpuError::Render(e.to_string()))?;
     let words = bytemuck::cast_slice(&view).to_vec();
     Ok(words)
-}
-
-/// Reads `count` words of `buffer` as integers.
-pub(super) fn read_u32s(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    buffer: &wgpu::Buffer,
-    count: usize,
-    errors: &ErrorSink,
-) -> Result<Vec<u32>, GpuError> {
-    read_words(device, queue, buffer, count, errors)
 }
 
 /// Reads `count` words of `buffer` as floats.

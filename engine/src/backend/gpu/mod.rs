@@ -496,7 +496,7 @@ impl GpuBackend {
                 }
             }
             self.queue.submit([enc.finish()]);
-            let c = device::read_u32s(d, &self.queue, &counters, 5, &self.errors)?;
+            let c = device::read_words(d, &self.queue, &counters, 5, &self.errors)?;
             for (total, c) in counts.iter_mut().zip(c) {
                 *total += u64::from(c);
             }
