@@ -177,3 +177,31 @@ fn a_compile_error_names_the_module_whose_code_caused_it() {
         Ok(_) => panic!("broken WGSL compiled"),
     }
 }
+
+#[test]
+fn progressive_passes_add_up_to_one_render() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let scene = radiant::scene::load(root.join("scenes/cornell-box.yaml")).unwrap();
+    let overrides = Overrides {
+        width: Some(24),
+        height: Some(16),
+        spp: Some(8),
+        ..Overrides::default()
+    };
+    let r = extract(&scene, &radiant::builtin_registry(), &overrides).unwrap();
+    let mut gpu = backend();
+    let none = radiant::backend::Progress::none();
+    let whole = gpu.render(&r, &none).unwrap().image;
+    let mut film = radiant::film::Film::new(24, 16);
+    for range in [0..3, 3..4, 4..8] {
+        gpu.render_samples(&r, &mut film, range, &none).unwrap();
+    }
+    let passes = film.develop();
+    for (a, b) in whole.pixels.iter().zip(&passes.pixels) {
+        assert!(
+            (*a - *b).abs().max_element() <= 1e-4 * a.max_element().max(1.0),
+            "{a} against {b}"
+        );
+    }
+    assert!(whole.mean() > 0.0);
+}

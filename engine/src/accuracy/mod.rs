@@ -30,10 +30,12 @@ pub mod twin;
 pub use reference::Reference;
 pub use sweep::{Axis, Curve, Setting};
 
+use crate::backend::gpu::{GpuBackend, GpuOptions};
 use crate::extract::Overrides;
 use crate::scene::{Scene, SceneError};
 use radiant_core::Registry;
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
 /// Errors of the accuracy report.
@@ -56,6 +58,12 @@ pub enum AccuracyError {
         /// Film width and height.
         film: (u32, u32),
     },
+    /// The GPU failed, or cannot render the scene.
+    #[error(transparent)]
+    Gpu(#[from] crate::backend::gpu::GpuError),
+    /// The `backend` axis was asked for without a GPU to measure.
+    #[error("the backend axis needs a hardware GPU: {0}")]
+    NoGpu(String),
     /// An output file could not be written.
     #[error("cannot write `{path}`: {message}")]
     Write {
@@ -186,6 +194,23 @@ pub fn run(
         budget: config.budget,
         sweep_time: start.elapsed(),
     })
+}
+
+/// The hardware GPU the `backend` axis measures on, opened once per
+/// process; why there is none otherwise (none found, or only a software
+/// one, whose speed says nothing).
+pub(crate) fn shared_gpu() -> Result<&'static Mutex<GpuBackend>, String> {
+    static GPU: OnceLock<Result<Mutex<GpuBackend>, String>> = OnceLock::new();
+    GPU.get_or_init(|| match GpuBackend::new(&GpuOptions::default()) {
+        Ok(g) if !g.is_software() => Ok(Mutex::new(g)),
+        Ok(g) => Err(format!(
+            "the only adapter, {}, is a software one",
+            g.adapter()
+        )),
+        Err(e) => Err(e.to_string()),
+    })
+    .as_ref()
+    .map_err(Clone::clone)
 }
 
 /// The files [`write()`] makes in its folder.

@@ -188,8 +188,9 @@ pub fn summary(report: &Report) -> String {
     };
     let _ = writeln!(
         md,
-        "Sweep: {} settings in {:.1} s (budget {:.1} s), CPU backend, {}×{} pixels. \
-         Time is extract (BVH build included) plus rendering, measured on this machine.\n",
+        "Sweep: {} settings in {:.1} s (budget {:.1} s), CPU backend (`backend=gpu`: the GPU \
+         backend), {}×{} pixels. Time is extract (BVH build included) plus rendering, measured \
+         on this machine.\n",
         curves.len(),
         report.sweep_time.as_secs_f64(),
         report.budget.as_secs_f64(),

@@ -38,11 +38,14 @@ pub enum Axis {
     LightSelection,
     /// BVH build quality (fast, medium, high): build time against trace time.
     Bvh,
+    /// The backend: the scene on the GPU (where a hardware adapter is
+    /// present) against the CPU baseline.
+    Backend,
 }
 
 impl Axis {
     /// Every axis, in report order.
-    pub const ALL: [Axis; 8] = [
+    pub const ALL: [Axis; 9] = [
         Axis::Spp,
         Axis::MaxDepth,
         Axis::RrDepth,
@@ -51,6 +54,7 @@ impl Axis {
         Axis::Sampler,
         Axis::LightSelection,
         Axis::Bvh,
+        Axis::Backend,
     ];
 
     /// The name used on the command line and in the CSV.
@@ -64,6 +68,7 @@ impl Axis {
             Axis::Sampler => "sampler",
             Axis::LightSelection => "light_selection",
             Axis::Bvh => "bvh",
+            Axis::Backend => "backend",
         }
     }
 
@@ -98,6 +103,8 @@ pub enum Change {
     LightSelection(LightSelection),
     /// BVH build quality.
     Bvh(BuildQuality),
+    /// Rendered by the GPU backend.
+    Gpu,
 }
 
 /// One setting of the sweep.
@@ -130,6 +137,7 @@ impl Setting {
             Change::LightSelection(LightSelection::Power) => "power".into(),
             Change::LightSelection(LightSelection::Uniform) => "uniform".into(),
             Change::Bvh(q) => format!("{q:?}").to_lowercase(),
+            Change::Gpu => "gpu".into(),
         }
     }
 
@@ -226,6 +234,13 @@ pub fn settings(scene: &Scene, registry: &Registry, axes: &[Axis]) -> (Vec<Setti
                 .into_iter()
                 .map(Change::Bvh)
                 .collect(),
+            Axis::Backend => match super::shared_gpu() {
+                Ok(_) => vec![Change::Gpu],
+                Err(why) => {
+                    notes.push(format!("backend: the GPU is not measured: {why}"));
+                    continue;
+                }
+            },
         };
         if changes.is_empty() {
             notes.push(format!("{axis}: only the scene's own value is registered"));
@@ -295,7 +310,14 @@ pub fn measure(
     let render = setting.extract(scene, registry, &overrides)?;
     let setup = extract_start.elapsed().as_secs_f64();
     reference.check_size(render.settings.width, render.settings.height)?;
-    let mut twin = TwinRender::new(scene, registry, render, limits.seed + 1)?;
+    let gpu = match setting.change {
+        Change::Gpu => {
+            crate::backend::gpu::Plan::new(&render)?;
+            Some(super::shared_gpu().map_err(AccuracyError::NoGpu)?)
+        }
+        _ => None,
+    };
+    let mut twin = TwinRender::new(scene, registry, render, limits.seed + 1)?.on_gpu(gpu);
     let mut points = Vec::new();
     twin.run_doubling(max_half, start, limits.share, |twin| {
         let images = TwinImages::of(twin);
@@ -307,6 +329,9 @@ pub fn measure(
             bias: bias_split(images.halves(), &reference.image, reference.halves()),
         });
     });
+    if let Some(e) = twin.take_error() {
+        return Err(e.into());
+    }
     Ok(Curve {
         setting: setting.clone(),
         setup,

@@ -4,6 +4,7 @@
 
 use super::metrics::Halves;
 use crate::backend::cpu::{Progress, render_samples};
+use crate::backend::gpu::{GpuBackend, GpuError};
 use crate::error::{SceneError, module_error};
 use crate::extract::RenderScene;
 use crate::film::{Film, Image};
@@ -11,6 +12,7 @@ use crate::scene::Scene;
 use glam::UVec2;
 use radiant_core::{BuildContext, Registry, Sampler, TextureTable};
 use std::collections::HashMap;
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 /// Two progressive renders of one [`RenderScene`] with different seeds.
@@ -22,6 +24,10 @@ pub struct TwinRender {
     films: [Film; 2],
     spp: u32,
     time: Duration,
+    /// The GPU that renders instead of the CPU (the `backend` axis).
+    gpu: Option<&'static Mutex<GpuBackend>>,
+    /// The GPU's first failure; rendering stops there.
+    error: Option<GpuError>,
 }
 
 /// Builds `scene`'s sampler for `seed` the way extract does (samplers use
@@ -61,7 +67,19 @@ impl TwinRender {
             films: [Film::new(w, h), Film::new(w, h)],
             spp: 0,
             time: Duration::ZERO,
+            gpu: None,
+            error: None,
         })
+    }
+
+    /// The same renders on `gpu` where it is given.
+    pub fn on_gpu(self, gpu: Option<&'static Mutex<GpuBackend>>) -> Self {
+        Self { gpu, ..self }
+    }
+
+    /// The GPU's failure, if rendering stopped on one.
+    pub fn take_error(&mut self) -> Option<GpuError> {
+        self.error.take()
     }
 
     /// Samples per pixel rendered so far in each half.
@@ -78,9 +96,22 @@ impl TwinRender {
     /// time this took.
     pub fn advance(&mut self, spp: u32) -> Duration {
         let mut took = Duration::ZERO;
-        if spp > self.spp {
+        if spp > self.spp && self.error.is_none() {
             for film in &mut self.films {
-                took += render_samples(&self.scene, film, self.spp..spp, &Progress::none()).time;
+                let range = self.spp..spp;
+                took += match self.gpu {
+                    None => render_samples(&self.scene, film, range, &Progress::none()).time,
+                    Some(gpu) => {
+                        let mut gpu = gpu.lock().unwrap_or_else(|e| e.into_inner());
+                        match gpu.render_samples(&self.scene, film, range, &Progress::none()) {
+                            Ok(pass) => pass.time,
+                            Err(e) => {
+                                self.error.get_or_insert(e);
+                                Duration::ZERO
+                            }
+                        }
+                    }
+                };
                 std::mem::swap(&mut self.scene.sampler, &mut self.other);
             }
             self.spp = spp;
@@ -108,6 +139,9 @@ impl TwinRender {
         let mut done = 0;
         loop {
             let per_sample = self.advance(spp).as_secs_f64() / (spp - done) as f64;
+            if self.error.is_some() {
+                break;
+            }
             let after_start = Instant::now();
             after_pass(self);
             let left = limit.as_secs_f64()

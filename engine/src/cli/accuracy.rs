@@ -29,8 +29,9 @@ pub struct AccuracyArgs {
     #[arg(long, default_value = "accuracy")]
     out: PathBuf,
     /// Sweep only these axes, comma-separated: spp, max_depth, rr_depth,
-    /// filter, filter_sampling, sampler, light_selection, bvh (the scene as
-    /// written is always measured).
+    /// filter, filter_sampling, sampler, light_selection, bvh, backend (the
+    /// GPU, where a hardware adapter is present; the scene as written is
+    /// always measured).
     #[arg(long, value_delimiter = ',')]
     only: Vec<String>,
     /// Largest samples per pixel of a setting.

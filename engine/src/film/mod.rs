@@ -308,6 +308,24 @@ impl Film {
         })
     }
 
+    /// Adds layers of per-pixel sums (Σ w·L in RGB, Σ w in alpha; each
+    /// layer `width × height` pixels, row-major) and `invalid` samples —
+    /// what the GPU backend renders.
+    ///
+    /// # Panics
+    ///
+    /// If `layers` is not a whole number of layers of this film's size.
+    pub fn add_layers(&mut self, layers: &[f32], invalid: u64) {
+        let layer = self.sums.len() * 4;
+        assert_eq!(layers.len() % layer.max(1), 0, "not whole layers");
+        for l in layers.chunks_exact(layer.max(1)) {
+            for (sum, p) in self.sums.iter_mut().zip(l.chunks_exact(4)) {
+                *sum += Vec4::new(p[0], p[1], p[2], p[3]);
+            }
+        }
+        self.invalid_samples += invalid;
+    }
+
     /// Adds a tile's sums.
     pub fn merge(&mut self, tile: &TileFilm) {
         for y in 0..tile.height {

@@ -22,11 +22,11 @@ pub mod upload;
 pub use device::GpuOptions;
 pub use error::GpuError;
 
+use super::cpu::Pass;
 use super::{Progress, Rendered};
 use crate::extract::RenderScene;
-use crate::film::Image;
+use crate::film::Film;
 use crate::integrators::path::UNLIMITED_DEPTH_CAP;
-use glam::Vec3;
 use kernel::{Features, Kernel};
 use modules::Modules;
 use std::time::Instant;
@@ -320,6 +320,41 @@ impl GpuBackend {
         scene: &RenderScene,
         progress: &Progress<'_>,
     ) -> Result<Rendered, GpuError> {
+        let s = &scene.settings;
+        let mut film =
+            Film::try_new(s.width, s.height).map_err(|e| GpuError::Render(e.to_string()))?;
+        let pass = self.render_samples(scene, &mut film, 0..s.spp, progress)?;
+        let image = film
+            .try_develop()
+            .map_err(|e| GpuError::Render(e.to_string()))?;
+        Ok(Rendered {
+            image,
+            time: pass.time,
+            samples: pass.samples,
+            rays: pass.rays,
+            invalid_samples: film.invalid_samples,
+        })
+    }
+
+    /// Progressive rendering, as [`cpu::render_samples`](crate::backend::cpu::render_samples)
+    /// does it: renders the sample indices `samples` of every pixel and
+    /// adds them to `film`, so consecutive ranges accumulate the image of
+    /// one render of all of them.
+    pub fn render_samples(
+        &mut self,
+        scene: &RenderScene,
+        film: &mut Film,
+        samples: std::ops::Range<u32>,
+        progress: &Progress<'_>,
+    ) -> Result<Pass, GpuError> {
+        let spp = samples.len() as u32;
+        if spp == 0 {
+            return Ok(Pass {
+                time: std::time::Duration::ZERO,
+                samples: 0,
+                rays: 0,
+            });
+        }
         let mut plan = Plan::new(scene)?;
         if self.stats {
             let features = kernel::Features {
@@ -337,7 +372,7 @@ impl GpuBackend {
         self.pipeline(&plan.kernel, (max_depth, s.rr_depth))?;
         let (w, h) = (s.width, s.height);
         let pixels = w as usize * h as usize;
-        let layers = ((1u64 << 20) / pixels as u64).clamp(1, MAX_LAYERS.min(s.spp) as u64) as u32;
+        let layers = ((1u64 << 20) / pixels as u64).clamp(1, MAX_LAYERS.min(spp) as u64) as u32;
         // Splatting: one film layer, and the dispatch's samples in layers
         // for the gather pass; importance sampling: the samples go into
         // film layers directly.
@@ -367,7 +402,7 @@ impl GpuBackend {
         let prims = storage(d, "prims", bytemuck::cast_slice(&g.prims), false);
         let shading = storage(d, "shading", bytemuck::cast_slice(&g.shading), false);
         let instances = storage(d, "instances", bytemuck::cast_slice(&g.instances), false);
-        let film = d.create_buffer(&wgpu::BufferDescriptor {
+        let film_buffer = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("film"),
             size: film_bytes as u64,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
@@ -381,7 +416,7 @@ impl GpuBackend {
             mapped_at_creation: false,
         });
         let reach = plan.modules.params[16];
-        let work = dispatches(w, h, s.spp, layers);
+        let work = dispatches(w, h, spp, layers);
         let mut slots = vec![0u32; work.len() * UNIFORM_STRIDE as usize / 4];
         for (k, job) in work.iter().enumerate() {
             let at = k * UNIFORM_STRIDE as usize / 4;
@@ -389,7 +424,7 @@ impl GpuBackend {
             slots[at..at + 7].copy_from_slice(&[
                 w,
                 h,
-                job.first,
+                samples.start + job.first,
                 job.samples,
                 job.y0,
                 job.rows,
@@ -437,7 +472,7 @@ impl GpuBackend {
                 },
                 wgpu::BindGroupEntry {
                     binding: 6,
-                    resource: film.as_entire_binding(),
+                    resource: film_buffer.as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 7,
@@ -450,7 +485,7 @@ impl GpuBackend {
             ],
         });
         self.errors.check()?;
-        let total = pixels as u64 * s.spp as u64;
+        let total = pixels as u64 * spp as u64;
         let start = Instant::now();
         let mut done = 0u64;
         let mut counts = [0u64; 5];
@@ -507,7 +542,7 @@ impl GpuBackend {
         let sums = device::read_f32s(
             d,
             &self.queue,
-            &film,
+            &film_buffer,
             pixels * film_layers * 4,
             &self.errors,
         )?;
@@ -519,27 +554,11 @@ impl GpuBackend {
             nodes: counts[3],
             prims: counts[4],
         };
-        let image = (0..pixels)
-            .map(|i| {
-                let (mut c, mut wsum) = (Vec3::ZERO, 0.0);
-                for layer in sums.chunks_exact(pixels * 4) {
-                    let p = &layer[4 * i..4 * i + 4];
-                    c += Vec3::new(p[0], p[1], p[2]);
-                    wsum += p[3];
-                }
-                if wsum != 0.0 { c / wsum } else { Vec3::ZERO }
-            })
-            .collect();
-        Ok(Rendered {
-            image: Image {
-                width: w,
-                height: h,
-                pixels: image,
-            },
+        film.add_layers(&sums, counts[0]);
+        Ok(Pass {
             time,
             samples: total,
             rays: counts[1] + counts[2],
-            invalid_samples: counts[0],
         })
     }
 }
