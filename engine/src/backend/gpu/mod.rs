@@ -4,11 +4,12 @@
 //! ([`modules`]), lays out the geometry ([`upload`], [`bvh`]), assembles
 //! the kernel from exactly what the frame uses ([`kernel`]), compiles it
 //! (or reuses the pipeline of an identical kernel: animation frames
-//! recompile nothing), uploads into buffers kept between frames, and
-//! renders the samples in dispatches small enough for OS watchdogs. One
-//! invocation renders one pixel's samples (a megakernel; see the README's
-//! GPU section for why), so accumulation needs no atomics and a render is
-//! deterministic for a given seed and adapter.
+//! recompile nothing), uploads the frame's buffers, and renders the
+//! samples in dispatches small enough for OS watchdogs. One invocation
+//! traces one path (a megakernel); each owns its film or splat entry, so
+//! accumulation needs no atomics and a render is deterministic for a given
+//! seed and adapter. (Buffers are made anew each frame; keeping them, and
+//! the bottom levels that did not change, is left to do.)
 
 mod bvh;
 mod device;
