@@ -177,6 +177,21 @@ pub struct GpuStats {
     pub prims: u64,
 }
 
+/// What the kernel of one call of [`GpuBackend::render_samples`] binds,
+/// kept while it runs.
+struct FrameBuffers {
+    /// Σ w·L and Σ w per pixel and film layer.
+    film: wgpu::Buffer,
+    /// Counts the kernel adds to (see [`GpuBackend::dispatch`]).
+    counters: wgpu::Buffer,
+    /// Every binding of the kernel (the bind group keeps its buffers).
+    bind: wgpu::BindGroup,
+    /// Layers of `film`.
+    film_layers: usize,
+    /// The filter's reach in pixels (the gather pass's border).
+    reach: u32,
+}
+
 /// The GPU backend: a device and what it keeps between frames.
 pub struct GpuBackend {
     device: wgpu::Device,
@@ -356,195 +371,21 @@ impl GpuBackend {
                 rays: 0,
             });
         }
-        let mut plan = Plan::new(scene)?;
-        if self.stats {
-            let features = kernel::Features {
-                stats: true,
-                ..plan.kernel.features
-            };
-            plan.kernel = Kernel::assemble(&plan.modules, features);
-        }
+        let plan = self.compile(scene)?;
         let s = &scene.settings;
-        let max_depth = if s.max_depth < 0 {
-            UNLIMITED_DEPTH_CAP
-        } else {
-            s.max_depth as u32
-        };
-        self.pipeline(&plan.kernel, (max_depth, s.rr_depth))?;
         let (w, h) = (s.width, s.height);
         let pixels = w as usize * h as usize;
         let layers = ((1u64 << 20) / pixels as u64).clamp(1, MAX_LAYERS.min(spp) as u64) as u32;
-        // Splatting: one film layer, and the dispatch's samples in layers
-        // for the gather pass; importance sampling: the samples go into
-        // film layers directly.
-        let splat = plan.kernel.features.splat;
-        let film_layers = if splat { 1 } else { layers as usize };
-        let film_bytes = pixels * film_layers * 16;
-        let splat_bytes = if splat {
-            pixels * layers as usize * 16
-        } else {
-            16
-        };
-        self.fits("the splatted samples", splat_bytes)?;
-        let g = &plan.geometry;
-        self.fits("the film", film_bytes)?;
-        self.fits("the BVH nodes", g.nodes.len() * 64)?;
-        self.fits("the primitives", g.prims.len() * 16)?;
-        self.fits("the shading data", g.shading.len() * 16)?;
-        self.fits("the module parameters", plan.modules.params.len() * 4)?;
-        let d = &self.device;
-        let params = storage(
-            d,
-            "params",
-            bytemuck::cast_slice(&plan.modules.params),
-            false,
-        );
-        let nodes = storage(d, "nodes", bytemuck::cast_slice(&g.nodes), false);
-        let prims = storage(d, "prims", bytemuck::cast_slice(&g.prims), false);
-        let shading = storage(d, "shading", bytemuck::cast_slice(&g.shading), false);
-        let instances = storage(d, "instances", bytemuck::cast_slice(&g.instances), false);
-        let film_buffer = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("film"),
-            size: film_bytes as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let counters = storage(d, "counters", &[0u8; 32], true);
-        let splats = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("splats"),
-            size: splat_bytes as u64,
-            usage: wgpu::BufferUsages::STORAGE,
-            mapped_at_creation: false,
-        });
-        let reach = plan.modules.params[16];
         let work = dispatches(w, h, spp, layers);
-        let mut slots = vec![0u32; work.len() * UNIFORM_STRIDE as usize / 4];
-        for (k, job) in work.iter().enumerate() {
-            let at = k * UNIFORM_STRIDE as usize / 4;
-            let gather_y0 = job.y0.saturating_sub(reach);
-            slots[at..at + 7].copy_from_slice(&[
-                w,
-                h,
-                samples.start + job.first,
-                job.samples,
-                job.y0,
-                job.rows,
-                gather_y0,
-            ]);
-        }
-        let uniform = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("dispatches"),
-            contents: bytemuck::cast_slice(&slots),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let compiled = self.pipeline.as_ref().expect("compiled above");
-        let (pipeline, gather) = (&compiled.pipeline, compiled.gather.as_ref());
-        let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("frame"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &uniform,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(32),
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: nodes.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: prims.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: shading.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: instances.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: film_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 7,
-                    resource: counters.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 8,
-                    resource: splats.as_entire_binding(),
-                },
-            ],
-        });
-        self.errors.check()?;
+        let frame = self.upload(&plan, (w, h), layers, samples.start, &work)?;
         let total = pixels as u64 * spp as u64;
         let start = Instant::now();
-        let mut done = 0u64;
-        let mut counts = [0u64; 5];
-        // Traversal counts reach 32 bits sooner than ray counts.
-        let per_submit = if self.stats {
-            PATHS_PER_SUBMIT >> 4
-        } else {
-            PATHS_PER_SUBMIT
-        };
-        let mut k = 0;
-        while k < work.len() {
-            // A run of dispatches of at most PATHS_PER_SUBMIT paths.
-            let mut enc = d.create_command_encoder(&Default::default());
-            let mut paths = 0u64;
-            {
-                let mut pass = enc.begin_compute_pass(&Default::default());
-                while k < work.len() {
-                    let job = work[k];
-                    let n = w as u64 * job.rows as u64 * job.samples as u64;
-                    if paths > 0 && paths + n > per_submit {
-                        break;
-                    }
-                    pass.set_pipeline(pipeline);
-                    pass.set_bind_group(0, &bind, &[(k as u64 * UNIFORM_STRIDE) as u32]);
-                    pass.dispatch_workgroups(
-                        w.div_ceil(WORKGROUP),
-                        job.rows.div_ceil(WORKGROUP),
-                        job.samples,
-                    );
-                    if let Some(gather) = gather {
-                        // The band's rows and the filter's reach around them.
-                        let top = job.y0.saturating_sub(reach);
-                        let bottom = (job.y0 + job.rows + reach).min(h);
-                        pass.set_pipeline(gather);
-                        pass.dispatch_workgroups(
-                            w.div_ceil(WORKGROUP),
-                            (bottom - top).div_ceil(WORKGROUP),
-                            1,
-                        );
-                    }
-                    paths += n;
-                    k += 1;
-                }
-            }
-            self.queue.submit([enc.finish()]);
-            let c = device::read_words(d, &self.queue, &counters, 5, &self.errors)?;
-            for (total, c) in counts.iter_mut().zip(c) {
-                *total += u64::from(c);
-            }
-            self.queue.write_buffer(&counters, 0, &[0u8; 32]);
-            done += paths;
-            progress.report(done, total);
-        }
+        let counts = self.dispatch(&frame, &work, (w, h), total, progress)?;
         let sums = device::read_f32s(
-            d,
+            &self.device,
             &self.queue,
-            &film_buffer,
-            pixels * film_layers * 4,
+            &frame.film,
+            pixels * frame.film_layers * 4,
             &self.errors,
         )?;
         let time = start.elapsed();
@@ -561,5 +402,195 @@ impl GpuBackend {
             samples: total,
             rays: counts[1] + counts[2],
         })
+    }
+
+    /// Plans `scene` (with the traversal counters where asked) and makes
+    /// sure its pipeline is compiled.
+    fn compile(&mut self, scene: &RenderScene) -> Result<Plan, GpuError> {
+        let mut plan = Plan::new(scene)?;
+        if self.stats {
+            let features = kernel::Features {
+                stats: true,
+                ..plan.kernel.features
+            };
+            plan.kernel = Kernel::assemble(&plan.modules, features);
+        }
+        let s = &scene.settings;
+        let max_depth = if s.max_depth < 0 {
+            UNLIMITED_DEPTH_CAP
+        } else {
+            s.max_depth as u32
+        };
+        self.pipeline(&plan.kernel, (max_depth, s.rr_depth))?;
+        Ok(plan)
+    }
+
+    /// The frame's buffers: `plan`'s parameters and geometry, the film
+    /// (one layer when splatting, `layers` otherwise), the splatted samples
+    /// (`layers` layers), the counters, and one uniform slot per dispatch
+    /// of `work` (sample indices from `first_sample` on).
+    fn upload(
+        &self,
+        plan: &Plan,
+        (w, h): (u32, u32),
+        layers: u32,
+        first_sample: u32,
+        work: &[Dispatch],
+    ) -> Result<FrameBuffers, GpuError> {
+        let pixels = w as usize * h as usize;
+        let splat = plan.kernel.features.splat;
+        let film_layers = if splat { 1 } else { layers as usize };
+        let splat_bytes = if splat {
+            pixels * layers as usize * 16
+        } else {
+            16
+        };
+        let g = &plan.geometry;
+        self.fits("the splatted samples", splat_bytes)?;
+        self.fits("the film", pixels * film_layers * 16)?;
+        self.fits("the BVH nodes", g.nodes.len() * 64)?;
+        self.fits("the primitives", g.prims.len() * 16)?;
+        self.fits("the shading data", g.shading.len() * 16)?;
+        self.fits("the module parameters", plan.modules.params.len() * 4)?;
+        let d = &self.device;
+        let reach = plan.modules.params[16];
+        let mut slots = vec![0u32; work.len() * UNIFORM_STRIDE as usize / 4];
+        for (k, job) in work.iter().enumerate() {
+            let at = k * UNIFORM_STRIDE as usize / 4;
+            slots[at..at + 7].copy_from_slice(&[
+                w,
+                h,
+                first_sample + job.first,
+                job.samples,
+                job.y0,
+                job.rows,
+                job.y0.saturating_sub(reach),
+            ]);
+        }
+        let uniform = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("dispatches"),
+            contents: bytemuck::cast_slice(&slots),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let empty = |label, size: usize, usage| {
+            d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size as u64,
+                usage: wgpu::BufferUsages::STORAGE | usage,
+                mapped_at_creation: false,
+            })
+        };
+        let read_only = [
+            storage(
+                d,
+                "params",
+                bytemuck::cast_slice(&plan.modules.params),
+                false,
+            ),
+            storage(d, "nodes", bytemuck::cast_slice(&g.nodes), false),
+            storage(d, "prims", bytemuck::cast_slice(&g.prims), false),
+            storage(d, "shading", bytemuck::cast_slice(&g.shading), false),
+            storage(d, "instances", bytemuck::cast_slice(&g.instances), false),
+        ];
+        let film = empty(
+            "film",
+            pixels * film_layers * 16,
+            wgpu::BufferUsages::COPY_SRC,
+        );
+        let counters = storage(d, "counters", &[0u8; 32], true);
+        let splats = empty("splats", splat_bytes, wgpu::BufferUsages::empty());
+        let mut entries = vec![wgpu::BindGroupEntry {
+            binding: 0,
+            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: &uniform,
+                offset: 0,
+                size: wgpu::BufferSize::new(32),
+            }),
+        }];
+        for (binding, buffer) in (1..).zip(read_only.iter().chain([&film, &counters, &splats])) {
+            entries.push(wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            });
+        }
+        let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("frame"),
+            layout: &self.layout,
+            entries: &entries,
+        });
+        self.errors.check()?;
+        Ok(FrameBuffers {
+            film,
+            counters,
+            bind,
+            film_layers,
+            reach,
+        })
+    }
+
+    /// Runs `work` in submissions of at most [`PATHS_PER_SUBMIT`] paths,
+    /// reading the counters after each (invalid samples, camera and
+    /// continuation rays, shadow rays, nodes, primitives) and reporting
+    /// progress towards `total` paths.
+    fn dispatch(
+        &self,
+        frame: &FrameBuffers,
+        work: &[Dispatch],
+        (w, h): (u32, u32),
+        total: u64,
+        progress: &Progress<'_>,
+    ) -> Result<[u64; 5], GpuError> {
+        let compiled = self.pipeline.as_ref().expect("compiled before dispatching");
+        let (pipeline, gather) = (&compiled.pipeline, compiled.gather.as_ref());
+        // Traversal counts reach 32 bits sooner than ray counts.
+        let per_submit = if self.stats {
+            PATHS_PER_SUBMIT >> 4
+        } else {
+            PATHS_PER_SUBMIT
+        };
+        let (mut counts, mut done, mut k) = ([0u64; 5], 0u64, 0);
+        while k < work.len() {
+            let mut enc = self.device.create_command_encoder(&Default::default());
+            let mut paths = 0u64;
+            {
+                let mut pass = enc.begin_compute_pass(&Default::default());
+                while let Some(job) = work.get(k) {
+                    let n = w as u64 * job.rows as u64 * job.samples as u64;
+                    if paths > 0 && paths + n > per_submit {
+                        break;
+                    }
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, &frame.bind, &[(k as u64 * UNIFORM_STRIDE) as u32]);
+                    pass.dispatch_workgroups(
+                        w.div_ceil(WORKGROUP),
+                        job.rows.div_ceil(WORKGROUP),
+                        job.samples,
+                    );
+                    if let Some(gather) = gather {
+                        // The band's rows and the filter's reach around them.
+                        let top = job.y0.saturating_sub(frame.reach);
+                        let bottom = (job.y0 + job.rows + frame.reach).min(h);
+                        pass.set_pipeline(gather);
+                        pass.dispatch_workgroups(
+                            w.div_ceil(WORKGROUP),
+                            (bottom - top).div_ceil(WORKGROUP),
+                            1,
+                        );
+                    }
+                    paths += n;
+                    k += 1;
+                }
+            }
+            self.queue.submit([enc.finish()]);
+            let c =
+                device::read_words(&self.device, &self.queue, &frame.counters, 5, &self.errors)?;
+            for (sum, c) in counts.iter_mut().zip(c) {
+                *sum += u64::from(c);
+            }
+            self.queue.write_buffer(&frame.counters, 0, &[0u8; 32]);
+            done += paths;
+            progress.report(done, total);
+        }
+        Ok(counts)
     }
 }
