@@ -53,6 +53,12 @@ impl Distribution1D {
         self.total
     }
 
+    /// The cumulative probabilities, `len() + 1` entries from 0 to 1 (what
+    /// a GPU side samples from).
+    pub fn cdf(&self) -> &[f32] {
+        &self.cdf
+    }
+
     /// Probability of cell `i`.
     #[inline]
     pub fn cell_probability(&self, i: usize) -> f32 {
@@ -108,6 +114,16 @@ impl Distribution2D {
     /// Sum of all weights.
     pub fn total(&self) -> f64 {
         self.marginal.total()
+    }
+
+    /// The distribution over rows.
+    pub fn marginal(&self) -> &Distribution1D {
+        &self.marginal
+    }
+
+    /// The distribution within each row, from y = 0 up.
+    pub fn rows(&self) -> &[Distribution1D] {
+        &self.rows
     }
 
     /// Samples a point of [0, 1)²; returns it and its cell.

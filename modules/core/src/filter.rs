@@ -63,6 +63,21 @@ impl FilterSampler {
         }
     }
 
+    /// The filter's radius in pixels.
+    pub fn radius(&self) -> f32 {
+        self.radius
+    }
+
+    /// f at the cell centres, row-major from (−r, −r).
+    pub fn values(&self) -> &[f32] {
+        &self.values
+    }
+
+    /// The distribution offsets are drawn from (proportional to |f|).
+    pub fn distribution(&self) -> &Distribution2D {
+        &self.distribution
+    }
+
     /// ∫|f| over the support, as tabulated.
     pub fn abs_integral(&self) -> f32 {
         self.abs_integral

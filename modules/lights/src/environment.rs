@@ -17,9 +17,9 @@
 //!
 //! The GPU side (`environment.wgsl`) samples and evaluates the same way from
 //! the same tables: the map's texels, cos θ per row, and the marginal and
-//! conditional CDFs of the distribution, rebuilt here exactly as
-//! [`Distribution1D`](radiant_core::distribution::Distribution1D) builds
-//! them (a test holds the two to the same densities and samples).
+//! conditional CDFs of the distribution itself
+//! ([`Distribution1D::cdf`](radiant_core::distribution::Distribution1D::cdf);
+//! a test holds the two to the same densities and samples).
 
 use crate::map_file::load_map;
 use crate::params::check_colour;
@@ -268,41 +268,16 @@ fn cell_weights(pixels: &[Rgb], size: UVec2, cos_theta: &[f32]) -> Vec<f32> {
     weights
 }
 
-/// The cumulative distribution of `weights` as
-/// [`Distribution1D::new`](radiant_core::distribution::Distribution1D::new)
-/// computes it (`n + 1` entries from 0 to 1; uniform if all are zero),
-/// appended to `out`.
-fn push_cdf(weights: &[f32], out: &mut Vec<f32>) {
-    let n = weights.len().max(1);
-    let total: f64 = weights.iter().map(|&w| w.max(0.0) as f64).sum();
-    out.push(0.0);
-    let mut acc = 0.0f64;
-    for i in 0..n {
-        acc += if total > 0.0 {
-            weights.get(i).map_or(0.0, |&w| w.max(0.0) as f64) / total
-        } else {
-            1.0 / n as f64
-        };
-        out.push(if i + 1 == n { 1.0 } else { acc as f32 });
-    }
-}
-
 impl Map {
     /// The map's words for `environment.wgsl` (see its header): size,
     /// the offsets of the tables, then cos θ per row, the marginal CDF of
     /// the cell rows, each cell row's conditional CDF and the texels.
     fn gpu_params(&self) -> &GpuParams {
         self.gpu.0.get_or_init(|| {
-            let (w, h) = (self.size.x as usize, self.size.y as usize);
-            let weights = cell_weights(&self.texels, self.size, &self.cos_theta);
-            let mut rows = Vec::with_capacity((h - 1) * (w + 1));
-            let mut totals = Vec::with_capacity(h - 1);
-            for row in weights.chunks_exact(w) {
-                totals.push(row.iter().map(|&x| x.max(0.0) as f64).sum::<f64>() as f32);
-                push_cdf(row, &mut rows);
-            }
-            let mut marginal = Vec::with_capacity(h);
-            push_cdf(&totals, &mut marginal);
+            let h = self.size.y as usize;
+            let d = &self.distribution;
+            let marginal = d.marginal().cdf();
+            let rows: Vec<f32> = d.rows().iter().flat_map(|r| r.cdf()).copied().collect();
             // Offsets from the light's first word: 17 words precede the tables.
             let cos_at = 17;
             let marginal_at = cos_at + h;
@@ -316,7 +291,7 @@ impl Map {
                 .u32(rows_at as u32)
                 .u32(texels_at as u32)
                 .f32s(self.cos_theta.iter().copied())
-                .f32s(marginal)
+                .f32s(marginal.iter().copied())
                 .f32s(rows)
                 .f32s(self.texels.iter().flat_map(|t| t.to_array()))
         })

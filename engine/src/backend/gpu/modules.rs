@@ -9,7 +9,9 @@
 
 use super::error::GpuError;
 use crate::extract::RenderScene;
-use radiant_core::{Effects, Filter, GpuLibrary, GpuModule, TextureId, TextureRef, TextureTable};
+use radiant_core::{
+    Effects, Filter, FilterSampler, GpuLibrary, GpuModule, TextureId, TextureRef, TextureTable,
+};
 
 /// Cells per axis of the tabulated filter.
 const FILTER_RES: u32 = 64;
@@ -128,50 +130,21 @@ impl Modules {
         at
     }
 
-    /// The filter tabulated as [`FilterSampler`](radiant_core::FilterSampler)
-    /// tabulates it: the marginal CDF of the rows, each row's CDF, then the
-    /// sign of f per cell.
+    /// The filter's [`FilterSampler`] tables: the marginal CDF of the rows,
+    /// each row's CDF, then the sign of f per cell.
     fn filter_table(&mut self, filter: &dyn Filter) {
-        let res = FILTER_RES as usize;
-        let radius = filter.radius();
-        let cell = 2.0 * radius / res as f32;
-        let values: Vec<f32> = (0..res * res)
-            .map(|i| {
-                let x = -radius + ((i % res) as f32 + 0.5) * cell;
-                let y = -radius + ((i / res) as f32 + 0.5) * cell;
-                filter.eval(x, y)
-            })
-            .collect();
-        let rows: Vec<f64> = values
-            .chunks(res)
-            .map(|r| r.iter().map(|v| v.abs() as f64).sum())
-            .collect();
-        let total: f64 = rows.iter().sum();
-        let mut table = Vec::with_capacity(res + 2 * res * res);
-        let cdf = |weights: &mut dyn Iterator<Item = f64>, sum: f64, out: &mut Vec<f32>| {
-            let mut acc = 0.0;
-            for (k, w) in weights.enumerate() {
-                acc += w;
-                out.push(if sum > 0.0 {
-                    (acc / sum) as f32
-                } else {
-                    (k + 1) as f32 / res as f32
-                });
-            }
-            if let Some(last) = out.last_mut() {
-                *last = 1.0;
-            }
-        };
-        cdf(&mut rows.iter().copied(), total, &mut table);
-        for (r, &sum) in values.chunks(res).zip(&rows) {
-            cdf(&mut r.iter().map(|v| v.abs() as f64), sum, &mut table);
+        let sampler = FilterSampler::new(filter, FILTER_RES);
+        let d = sampler.distribution();
+        // The CDFs without their leading 0, as `filter_sample` reads them.
+        let mut table: Vec<f32> = d.marginal().cdf()[1..].to_vec();
+        for row in d.rows() {
+            table.extend_from_slice(&row.cdf()[1..]);
         }
-        table.extend(values.iter().map(|v| 1.0f32.copysign(*v)));
-        let integral = (total * (cell * cell) as f64) as f32;
+        table.extend(sampler.values().iter().map(|v| 1.0f32.copysign(*v)));
         self.params[3] = self.params.len() as u32;
         self.params[4] = FILTER_RES;
-        self.params[5] = radius.to_bits();
-        self.params[6] = integral.to_bits();
+        self.params[5] = sampler.radius().to_bits();
+        self.params[6] = sampler.abs_integral().to_bits();
         self.params.extend(table.iter().map(|v| v.to_bits()));
     }
 
