@@ -18,20 +18,21 @@ use radiant_tests::{Tolerances, check_against};
 /// that the GPU image matches the CPU one within `tolerances`, and that a
 /// 2 % scale of the GPU image would not.
 fn agrees(scene: &str, size: u32, spp: u32, tolerances: Tolerances) {
-    agrees_with(scene, size, spp, tolerances, None);
+    agrees_with(scene, [size, size], spp, tolerances, None);
 }
 
-/// [`agrees`] with the film's filter sampling set to `sampling`.
+/// [`agrees`] at `width`×`height` pixels with the film's filter sampling
+/// set to `sampling`.
 fn agrees_with(
     scene: &str,
-    size: u32,
+    [width, height]: [u32; 2],
     spp: u32,
     tolerances: Tolerances,
     sampling: Option<FilterSampling>,
 ) {
     let overrides = Overrides {
-        width: Some(size),
-        height: Some(size),
+        width: Some(width),
+        height: Some(height),
         spp: Some(spp),
         filter_sampling: sampling,
         ..Overrides::default()
@@ -71,7 +72,7 @@ fn cornell_box() {
 fn cornell_box_with_filter_importance_sampling() {
     agrees_with(
         "scenes/cornell-box.yaml",
-        48,
+        [48, 48],
         64,
         CLOSE,
         Some(FilterSampling::Importance),
@@ -131,4 +132,35 @@ fn textured_mesh() {
 #[test]
 fn torture_glass_ior_1() {
     agrees("scenes/hard/glass-ior-1.yaml", 48, 64, CLOSE);
+}
+
+/// Anisotropic GGX on a sphere and on a mesh with MikkTSpace tangents:
+/// shading frames oriented by the parametrization.
+#[test]
+fn anisotropic_tangent_frames() {
+    agrees_with(
+        "tests/data/tangents/anisotropic.yaml",
+        [64, 32],
+        64,
+        CLOSE,
+        None,
+    );
+}
+
+/// A normal map on rectangles (turned) and on a mesh with tangents.
+#[test]
+fn normal_map() {
+    agrees_with(
+        "tests/data/tangents/normal-map.yaml",
+        [96, 32],
+        64,
+        CLOSE,
+        None,
+    );
+}
+
+/// A bump map on rectangles, differentiated along their ∂p/∂u, ∂p/∂v.
+#[test]
+fn bump_map() {
+    agrees_with("tests/data/tangents/bump.yaml", [64, 32], 64, CLOSE, None);
 }

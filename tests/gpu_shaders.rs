@@ -28,8 +28,8 @@ use std::path::Path;
 /// Random records per shader configuration (a few special ones are added).
 const RECORDS: usize = 4096;
 
-/// Floats per input record: wo, uv, u, wi.
-const INPUTS: usize = 11;
+/// Floats per input record: wo, uv, u, wi, ∂p/∂u, ∂p/∂v.
+const INPUTS: usize = 17;
 
 /// Floats per output record: the sample's wi, weight, pdf, delta and eta,
 /// then the evaluation's value and pdf.
@@ -71,6 +71,8 @@ struct Record {
     uv: Vec2,
     u: Vec3,
     wi: Vec3,
+    dp_du: Vec3,
+    dp_dv: Vec3,
 }
 
 /// SplitMix64: a small deterministic generator for the inputs.
@@ -99,16 +101,23 @@ impl Rng {
     }
 }
 
-/// The scene holding `materials` as `m0`, `m1`, …, extracted.
+/// The scene holding `materials` as `m0`, `m1`, …, extracted, with the
+/// image textures `ridges` (a height field) and `bumps` (a normal map) of
+/// `data/tangents` for them to read.
 fn scene(materials: &[&str]) -> RenderScene {
     let mut text = String::from(
-        "camera: {type: perspective, fov: 45, look_at: {origin: [0, 0, 3], target: [0, 0, 0], up: [0, 1, 0]}}\nmaterials:\n",
+        "camera: {type: perspective, fov: 45, look_at: {origin: [0, 0, 3], target: [0, 0, 0], up: [0, 1, 0]}}
+textures:
+  ridges: {type: image, filename: ridges-height.png, raw: true}
+  bumps: {type: image, filename: ridges-normals.png, raw: true}
+materials:\n",
     );
     for (i, m) in materials.iter().enumerate() {
         let _ = writeln!(text, "  m{i}: {m}");
     }
     text += "shapes:\n  - {type: sphere, center: [0, 0, 0], radius: 1, material: m0}\n";
-    let loaded = radiant::scene::from_str(&text, Path::new("gpu_shaders.yaml"), Path::new("."))
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/tangents");
+    let loaded = radiant::scene::from_str(&text, Path::new("gpu_shaders.yaml"), &data)
         .unwrap_or_else(|e| panic!("the test scene parses: {e}\n{text}"));
     extract(&loaded, &radiant::builtin_registry(), &Overrides::default())
         .unwrap_or_else(|e| panic!("the test scene extracts: {e}\n{text}"))
@@ -121,8 +130,15 @@ fn cpu(scene: &RenderScene, m: usize, records: &[Record]) -> Vec<[f32; OUTPUTS]>
     let uv: Vec<Vec2> = records.iter().map(|r| r.uv).collect();
     let u: Vec<Vec3> = records.iter().map(|r| r.u).collect();
     let wi: Vec<Vec3> = records.iter().map(|r| r.wi).collect();
+    let dp_du: Vec<Vec3> = records.iter().map(|r| r.dp_du).collect();
+    let dp_dv: Vec<Vec3> = records.iter().map(|r| r.dp_dv).collect();
     let mut ctx = ShadeContext::new(&scene.textures);
-    let surface = SurfaceBatch::new(&wo, &uv);
+    let surface = SurfaceBatch {
+        wo: &wo,
+        uv: &uv,
+        dp_du: &dp_du,
+        dp_dv: &dp_dv,
+    };
     let mut samples = vec![BsdfSample::default(); records.len()];
     shader.sample(&mut ctx, surface, &u, &mut samples);
     let mut evals = vec![BsdfEval::default(); records.len()];
@@ -154,7 +170,7 @@ fn cpu(scene: &RenderScene, m: usize, records: &[Record]) -> Vec<[f32; OUTPUTS]>
 /// (WGSL that may change the sample `r`) in between.
 fn body(ident: &str, tamper: &str) -> String {
     format!(
-        "let s = ShadingPoint(vec3f(input(i, 0u), input(i, 1u), input(i, 2u)), vec2f(input(i, 3u), input(i, 4u)));
+        "let s = ShadingPoint(vec3f(input(i, 0u), input(i, 1u), input(i, 2u)), vec2f(input(i, 3u), input(i, 4u)), vec3f(input(i, 11u), input(i, 12u), input(i, 13u)), vec3f(input(i, 14u), input(i, 15u), input(i, 16u)));
 let u = vec3f(input(i, 5u), input(i, 6u), input(i, 7u));
 let wi = vec3f(input(i, 8u), input(i, 9u), input(i, 10u));
 var r = bsdf_sample_{ident}(P, s, u);
@@ -188,7 +204,8 @@ fn gpu(
         .iter()
         .flat_map(|r| {
             [
-                r.wo.x, r.wo.y, r.wo.z, r.uv.x, r.uv.y, r.u.x, r.u.y, r.u.z, r.wi.x, r.wi.y, r.wi.z,
+                r.wo.x, r.wo.y, r.wo.z, r.uv.x, r.uv.y, r.u.x, r.u.y, r.u.z, r.wi.x, r.wi.y,
+                r.wi.z, r.dp_du.x, r.dp_du.y, r.dp_du.z, r.dp_dv.x, r.dp_dv.y, r.dp_dv.z,
             ]
         })
         .collect();
@@ -216,7 +233,8 @@ fn gpu(
 }
 
 /// The records of a case: random ones, and a few special ones (normal
-/// incidence from both sides, grazing, u at 0). Incident directions for
+/// incidence from both sides, grazing, u at 0). Surface derivatives are
+/// random vectors of lengths 0.1 to 2. Incident directions for
 /// evaluation are uniform on the sphere for even records and the CPU's
 /// sampled direction (in the lobe) for odd ones, so that narrow lobes are
 /// evaluated where they are not zero.
@@ -228,6 +246,8 @@ fn records(scene: &RenderScene, m: usize, seed: u64) -> Vec<Record> {
             uv: Vec2::new(rng.float(), rng.float()),
             u: Vec3::new(rng.float(), rng.float(), rng.float()),
             wi: rng.sphere(),
+            dp_du: rng.sphere() * (0.1 + 1.9 * rng.float()),
+            dp_dv: rng.sphere() * (0.1 + 1.9 * rng.float()),
         })
         .collect();
     let specials = [
@@ -256,6 +276,8 @@ fn records(scene: &RenderScene, m: usize, seed: u64) -> Vec<Record> {
             uv: Vec2::splat(0.5),
             u,
             wi,
+            dp_du: Vec3::X,
+            dp_dv: Vec3::Y,
         });
     }
     let sampled = cpu(scene, m, &recs);
@@ -590,14 +612,34 @@ shapes:
     assert!(sum > 0.0, "the spheres are lit");
 }
 
-/// Blends without a GPU side where a part has none (bump and normal maps
-/// need tangent frames the GPU does not have yet).
 #[test]
-fn blend_of_a_part_without_gpu_code_has_none() {
-    let scene = scene(&[
-        "{type: blend, materials: [{type: diffuse}, {type: bump, height: 0.5, material: {type: diffuse}}]}",
+fn normal_map() {
+    agree(&[
+        "{type: normal_map, normals: bumps, material: {type: diffuse, reflectance: 0.8}}",
+        "{type: normal_map, normals: [0.75, 0.4, 0.85], material: {type: conductor, material: Cu, alpha_u: 0.4, alpha_v: 0.05}}",
+        "{type: normal_map, normals: bumps, flip_invalid_normals: false, use_shadowing_function: false, material: {type: plastic, alpha: 0.1}}",
+        "{type: normal_map, normals: bumps, material: {type: dielectric, alpha: 0.3}}",
     ]);
-    assert!(scene.shaders[0].gpu().is_none());
+}
+
+#[test]
+fn bump() {
+    agree(&[
+        "{type: bump, height: ridges, scale: 0.1, material: {type: diffuse, reflectance: [0.7, 0.5, 0.3]}}",
+        "{type: bump, height: ridges, scale: -0.02, material: {type: conductor, material: Au, alpha: 0.2}}",
+        "{type: bump, height: ridges, scale: 0.05, use_shadowing_function: false, material: {type: ward, alpha_u: 0.3, alpha_v: 0.05}}",
+    ]);
+}
+
+/// Wrappers inside blends and blends inside wrappers: the nested
+/// composite's code is included renamed.
+#[test]
+fn composites_nest() {
+    agree(&[
+        "{type: blend, weight: 0.4, materials: [{type: diffuse}, {type: bump, height: ridges, scale: 0.05, material: {type: conductor, alpha: 0.3}}]}",
+        "{type: normal_map, normals: bumps, material: {type: blend, weight: 0.5, materials: [{type: diffuse}, {type: plastic, alpha: 0.2}]}}",
+        "{type: bump, height: ridges, scale: 0.05, material: {type: normal_map, normals: [0.6, 0.5, 0.9], material: {type: rough_diffuse, alpha: 0.5}}}",
+    ]);
 }
 
 /// A probe whose shader scales the sample weight by 1.02 fails the

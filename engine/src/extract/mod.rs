@@ -40,7 +40,7 @@ use crate::settings::RenderSettings;
 use crate::world::{MeshRepairs, Scene};
 use glam::{Vec2, Vec3};
 use radiant_core::{
-    Camera, Effects, Filter, Frame, ModuleKind, Registry, Sampler, Shader, TextureTable,
+    Camera, Effects, Filter, Frame, ModuleKind, Registry, Sampler, Shader, TextureId, TextureTable,
 };
 use std::collections::BTreeSet;
 use std::time::Duration;
@@ -134,6 +134,9 @@ pub struct RenderScene {
     pub lights: LightTable,
     /// Light module types, per light index.
     pub light_types: Vec<String>,
+    /// The named textures of the scene's `textures:` section: (id, name,
+    /// module type), for messages (inline textures have no name).
+    pub texture_names: Vec<(TextureId, String, String)>,
     /// The camera.
     pub camera: Box<dyn Camera>,
     /// How camera rays move while the shutter is open: the transform from

@@ -290,6 +290,16 @@ impl ModuleState {
         self.lights.iter().map(|s| s.type_name(scene)).collect()
     }
 
+    /// The named textures: (id, name, module type).
+    pub(super) fn texture_names(&self, scene: &Scene) -> Vec<(TextureId, String, String)> {
+        scene
+            .textures
+            .iter()
+            .zip(&self.texture_ids)
+            .map(|((name, spec), &id)| (id, name.clone(), spec.type_name.clone()))
+            .collect()
+    }
+
     /// Rebuilds what changed since the last frame in `render`: textures
     /// and materials whose parameters (or whose named inputs) changed,
     /// lights whose parameters, shape, transform or scene sphere changed,

@@ -209,6 +209,7 @@ pub(super) fn build(
             .map(|(_, spec)| spec.type_name.clone())
             .collect(),
         light_types: modules.light_types(scene),
+        texture_names: modules.texture_names(scene),
         lights: initial.lights,
         camera: initial.camera,
         camera_motion: camera_motion(scene, render_origin),

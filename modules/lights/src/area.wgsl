@@ -149,15 +149,6 @@ fn sphere_cone(centre: vec3f, radius: f32, origin: vec3f) -> vec3f {
     return vec3f(sin2_max, cos_max, one_minus);
 }
 
-fn frame_from_normal(n: vec3f) -> mat3x3f {
-    let sgn = select(-1.0, 1.0, n.z >= 0.0);
-    let a = -1.0 / (sgn + n.z);
-    let b = n.x * n.y * a;
-    let s = vec3f(1.0 + sgn * n.x * n.x * a, sgn * b, -sgn * n.x);
-    let t = vec3f(b, sgn + n.y * n.y * a, -n.y);
-    return mat3x3f(s, t, n);
-}
-
 // ---- The light ----
 
 fn light_sample_area(p: u32, r: vec3f, u: vec2f) -> LightSample {

@@ -13,7 +13,8 @@
 //! hold the parts'. WGSL has no recursion, so the kernel's generic
 //! `bsdf_sample` dispatcher (which dispatches to blends too) cannot be
 //! used; a part's code must be in libraries (as every built-in type's is,
-//! see [`crate::gpu`]) or be a blend's, whose code is included renamed.
+//! see [`crate::gpu`]) or be a composite's (a blend, a normal or bump map),
+//! whose code is included renamed.
 
 use crate::gpu;
 use crate::inputs::{fraction, half, scalar, texture_effects};
@@ -25,7 +26,6 @@ use radiant_core::{
 };
 use serde::Deserialize;
 use serde::de::IgnoredAny;
-use std::borrow::Cow;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -223,52 +223,29 @@ impl Shader for Blend {
     }
 
     /// Where both parts have a GPU side whose code is in libraries or is
-    /// a blend's (see the module docs).
+    /// a composite's (see the module docs).
     fn gpu(&self) -> Option<GpuModule> {
         let [a, b] = [self.parts[0].gpu()?, self.parts[1].gpu()?];
-        // Unique per pair of part types (the length makes it decodable),
-        // so that one identifier always means the same code.
-        let ident = format!("{BLEND_PREFIX}{}_{}_{}", a.ident.len(), a.ident, b.ident);
-        let mut wgsl = String::new();
-        let mut libraries = vec![gpu::COMMON];
-        let mut names = Vec::with_capacity(2);
-        for (part, suffix) in [(&a, "__a"), (&b, "__b")] {
-            libraries.extend_from_slice(part.requires);
-            if !part.wgsl.contains("fn ") {
-                names.push(part.ident.to_string());
-            } else if part.ident.starts_with(BLEND_PREFIX) {
-                // Every name in a blend's code contains its identifier:
-                // renamed, a nested blend's code cannot clash with the same
-                // blend's elsewhere in the kernel.
-                let renamed = format!("{ident}{suffix}");
-                wgsl += &part.wgsl.replace(&*part.ident, &renamed);
-                names.push(renamed);
-            } else {
-                return None;
-            }
-        }
-        wgsl += &BLEND_WGSL
-            .split_once("\n\n")
-            .map_or(BLEND_WGSL, |(_header, code)| code)
-            .replace("$SELF", &ident)
-            .replace("$A", &names[0])
-            .replace("$B", &names[1]);
+        // Unique per pair of part types (the length makes it decodable).
+        let ident = format!(
+            "{}{}_{}_{}",
+            gpu::BLEND_PREFIX,
+            a.ident.len(),
+            a.ident,
+            b.ident
+        );
+        let mut code = gpu::Composite::new(ident, &[gpu::COMMON]);
+        let name_a = code.part(&a, "__a")?;
+        let name_b = code.part(&b, "__b")?;
+        code.template(BLEND_WGSL, &[("$A", &name_a), ("$B", &name_b)]);
         let params = GpuParams::new()
             .texture(self.weight)
             .u32(2 + a.params.len() as u32)
             .append(&a.params)
             .append(&b.params);
-        Some(GpuModule {
-            ident: Cow::Owned(ident),
-            wgsl: Cow::Owned(wgsl),
-            requires: gpu::interned(&libraries),
-            params,
-        })
+        Some(code.finish(params))
     }
 }
-
-/// The start of every blend's GPU identifier.
-const BLEND_PREFIX: &str = "blend_";
 
 /// The template of a blend's WGSL (its header comment, up to the first
 /// blank line, is left out of the code made from it).

@@ -12,8 +12,8 @@ use crate::perturb::{self, NormalSource, PerturbOptions, Perturbed};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BuildContext, ParamDoc, ParamError, Params, Registry, ShadeContext, SurfaceBatch, TextureId,
-    TextureInput,
+    BuildContext, GpuParams, ParamDoc, ParamError, Params, Registry, ShadeContext, SurfaceBatch,
+    TextureId, TextureInput,
 };
 use serde::Deserialize;
 use serde::de::IgnoredAny;
@@ -97,6 +97,11 @@ impl NormalSource for BumpNormals {
         }
         ctx.recycle(shifted);
         normals
+    }
+
+    fn gpu(&self) -> (&'static str, &'static str, GpuParams) {
+        let params = GpuParams::new().texture(self.height).f32(self.scale);
+        ("bump", include_str!("bump.wgsl"), params)
     }
 }
 

@@ -11,6 +11,7 @@
 //! `bsdf_sample` dispatcher, which would call the blend again).
 
 use radiant_core::{GpuLibrary, GpuModule, GpuParams};
+use std::borrow::Cow;
 use std::sync::Mutex;
 
 /// Scalar texture inputs, luminance, glam's `try_normalize`.
@@ -40,6 +41,13 @@ pub(crate) const LOBES: GpuLibrary = GpuLibrary {
     name: "shaders::lobes",
     wgsl: include_str!("gpu/lobes.wgsl"),
     requires: &[COMMON, MICROFACET, FRESNEL],
+};
+
+/// What `normal_map` and `bump` share (`perturb.rs`).
+pub(crate) const PERTURB: GpuLibrary = GpuLibrary {
+    name: "shaders::perturb",
+    wgsl: include_str!("gpu/perturb.wgsl"),
+    requires: &[COMMON],
 };
 
 /// What `ward` and `ashikhmin_shirley` share (`half_vector.rs`).
@@ -133,6 +141,81 @@ pub(crate) fn module(
     GpuModule::new(ident, CODE_IN_LIBRARY, params).with_libraries(code)
 }
 
+/// The start of every blend's GPU identifier.
+pub(crate) const BLEND_PREFIX: &str = "blend_";
+
+/// The start of every `normal_map`'s and `bump`'s GPU identifier.
+pub(crate) const PERTURBED_PREFIX: &str = "perturbed_";
+
+/// The WGSL of a composite type (a `blend`, a `normal_map`, a `bump`):
+/// code made from templates per combination of its parts' types, calling
+/// their functions directly (WGSL forbids the recursion a call through the
+/// kernel's `bsdf_sample` dispatcher would be). Every name in a
+/// composite's code contains its identifier, so that one identifier always
+/// means the same code and a composite nested in another can be included
+/// renamed.
+pub(crate) struct Composite {
+    ident: String,
+    wgsl: String,
+    libraries: Vec<GpuLibrary>,
+}
+
+impl Composite {
+    /// A composite named `ident` whose templates call `libraries`.
+    pub(crate) fn new(ident: String, libraries: &[GpuLibrary]) -> Self {
+        Self {
+            ident,
+            wgsl: String::new(),
+            libraries: libraries.to_vec(),
+        }
+    }
+
+    /// Adds the part `part` and returns the identifier its functions are
+    /// called by: its own where its code is in libraries (every built-in
+    /// type's), `<this identifier><suffix>` where it is a composite, whose
+    /// code is included renamed; `None` for a type whose code is its
+    /// module's own (an outside crate's), which cannot be renamed safely.
+    pub(crate) fn part(&mut self, part: &GpuModule, suffix: &str) -> Option<String> {
+        self.libraries.extend_from_slice(part.requires);
+        if !part.wgsl.contains("fn ") {
+            return Some(part.ident.to_string());
+        }
+        let composite = [BLEND_PREFIX, PERTURBED_PREFIX]
+            .iter()
+            .any(|prefix| part.ident.starts_with(prefix));
+        if !composite {
+            return None;
+        }
+        let renamed = format!("{}{suffix}", self.ident);
+        self.wgsl += &part.wgsl.replace(&*part.ident, &renamed);
+        Some(renamed)
+    }
+
+    /// Adds the code of `template` (its header comment, up to the first
+    /// blank line, left out) with `$SELF` and each `(from, to)` of
+    /// `names` replaced.
+    pub(crate) fn template(&mut self, template: &str, names: &[(&str, &str)]) {
+        let mut code = template
+            .split_once("\n\n")
+            .map_or(template, |(_header, code)| code)
+            .replace("$SELF", &self.ident);
+        for (from, to) in names {
+            code = code.replace(from, to);
+        }
+        self.wgsl += &code;
+    }
+
+    /// The module with the composite's code and `params`.
+    pub(crate) fn finish(self, params: GpuParams) -> GpuModule {
+        GpuModule {
+            requires: interned(&self.libraries),
+            ident: Cow::Owned(self.ident),
+            wgsl: Cow::Owned(self.wgsl),
+            params,
+        }
+    }
+}
+
 /// `libraries` (sorted by name, each once) as a `'static` slice, for a
 /// module whose libraries are only known from its parts (`blend`). Each
 /// distinct set is allocated once and kept for the process's lifetime:
@@ -154,4 +237,42 @@ pub(crate) fn interned(libraries: &[GpuLibrary]) -> &'static [GpuLibrary] {
     let leaked: &'static [GpuLibrary] = Box::leak(set.into_boxed_slice());
     sets.push(leaked);
     leaked
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Parts whose code is in libraries are called by their own names,
+    /// composites' code is included renamed, and a type whose code is its
+    /// module's own (an outside crate's) cannot be a part.
+    #[test]
+    fn composites_take_library_and_composite_parts_only() {
+        let mut code = Composite::new("blend_3_abc_def".into(), &[COMMON]);
+        let library = module("diffuse", &[DIFFUSE], GpuParams::new());
+        assert_eq!(code.part(&library, "__a").as_deref(), Some("diffuse"));
+        let nested = GpuModule {
+            ident: Cow::Borrowed("blend_1_x_y"),
+            wgsl: Cow::Borrowed("fn bsdf_eval_blend_1_x_y() {}\n"),
+            requires: &[],
+            params: GpuParams::new(),
+        };
+        assert_eq!(
+            code.part(&nested, "__b").as_deref(),
+            Some("blend_3_abc_def__b")
+        );
+        let outside = GpuModule::new("stripes", "fn bsdf_eval_stripes() {}\n", GpuParams::new());
+        assert_eq!(code.part(&outside, "__c"), None);
+        code.template(
+            "// header\n\nfn f_$SELF() { g_$A(); }\n",
+            &[("$A", "diffuse")],
+        );
+        let m = code.finish(GpuParams::new());
+        assert_eq!(
+            m.wgsl,
+            "fn bsdf_eval_blend_3_abc_def__b() {}\nfn f_blend_3_abc_def() { g_diffuse(); }\n"
+        );
+        let names: Vec<_> = m.requires.iter().map(|l| l.name).collect();
+        assert_eq!(names, ["shaders::common", "shaders::diffuse"]);
+    }
 }

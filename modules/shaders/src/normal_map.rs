@@ -10,8 +10,8 @@ use crate::perturb::{self, NormalSource, PerturbOptions, Perturbed};
 use radiant_core::glam::Vec3;
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BuildContext, ParamDoc, ParamError, Params, Registry, ShadeContext, SurfaceBatch, TextureId,
-    TextureInput,
+    BuildContext, GpuParams, ParamDoc, ParamError, Params, Registry, ShadeContext, SurfaceBatch,
+    TextureId, TextureInput,
 };
 use serde::Deserialize;
 use serde::de::IgnoredAny;
@@ -61,6 +61,11 @@ impl NormalSource for MapNormals {
             *normal = perturb::sanitise(2.0 * *c - Vec3::ONE);
         }
         normals
+    }
+
+    fn gpu(&self) -> (&'static str, &'static str, GpuParams) {
+        let params = GpuParams::new().texture(self.normals);
+        ("normal_map", include_str!("normal_map.wgsl"), params)
     }
 }
 

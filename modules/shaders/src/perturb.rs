@@ -23,10 +23,11 @@
 //! is read in uv tangent space and a bump map is differentiated along the
 //! surface's real ∂p/∂u and ∂p/∂v.
 
+use crate::gpu;
 use radiant_core::glam::Vec3;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, Frame, ParamDoc, ParamError, Params, ShadeContext,
-    Shader, SurfaceBatch, TextureId,
+    BsdfEval, BsdfSample, BuildContext, Effects, Frame, GpuModule, GpuParams, ParamDoc, ParamError,
+    Params, ShadeContext, Shader, SurfaceBatch, TextureId,
 };
 
 /// ∂p/∂u and ∂p/∂v of point `i` of `surface` (local frame), or the unit
@@ -47,6 +48,11 @@ pub(crate) trait NormalSource: Send + Sync + 'static {
     /// coordinates, above the surface), in a buffer taken from `ctx` that
     /// the caller recycles.
     fn normals(&self, ctx: &mut ShadeContext<'_>, surface: SurfaceBatch<'_>) -> Vec<Vec3>;
+
+    /// The GPU side: the source's name, its WGSL template defining
+    /// `perturbed_normal_$SELF(p: u32, s: ShadingPoint) -> vec3f` (the
+    /// normal at `s`, reading the parameters at `p`), and its parameters.
+    fn gpu(&self) -> (&'static str, &'static str, GpuParams);
 }
 
 /// The options both wrappers share (Mitsuba 3's names and defaults).
@@ -271,7 +277,36 @@ impl<N: NormalSource> Shader for Perturbed<N> {
     fn effects(&self) -> Effects {
         self.effects
     }
+
+    /// `perturb.wgsl` around the source's normals, where the nested
+    /// material has a GPU side whose code is in libraries or is a
+    /// composite's (see [`crate::gpu::Composite`]).
+    fn gpu(&self) -> Option<GpuModule> {
+        let nested = self.nested.gpu()?;
+        let (name, normals, source) = self.source.gpu();
+        let ident = format!(
+            "{}{name}_{}_{}",
+            gpu::PERTURBED_PREFIX,
+            nested.ident.len(),
+            nested.ident
+        );
+        let mut code = gpu::Composite::new(ident, &[gpu::PERTURB]);
+        let m = code.part(&nested, "__m")?;
+        code.template(normals, &[]);
+        code.template(PERTURBED_WGSL, &[("$M", &m)]);
+        let flags = u32::from(self.options.flip_invalid_normals)
+            | u32::from(self.options.use_shadowing_function) << 1;
+        let params = GpuParams::new()
+            .u32(2 + source.len() as u32)
+            .u32(flags)
+            .append(&source)
+            .append(&nested.params);
+        Some(code.finish(params))
+    }
 }
+
+/// The template of a wrapper's WGSL (`$M`: the nested material).
+const PERTURBED_WGSL: &str = include_str!("perturb.wgsl");
 
 /// Unit normal from a tangent-space vector, falling back to +z for a
 /// degenerate one or one below the surface.

@@ -32,6 +32,9 @@ pub struct Features {
     pub spheres: bool,
     /// Textures that vary (interpolated texture coordinates).
     pub textures: bool,
+    /// Shading frames oriented by the surface's parametrization, with its
+    /// derivatives (anisotropic lobes, normal and bump maps).
+    pub tangent_frames: bool,
     /// Any light (next-event estimation).
     pub lights: bool,
     /// Surfaces that emit.
@@ -53,6 +56,7 @@ impl Features {
             instances: geometry.instanced,
             spheres: geometry.spheres,
             textures: scene.effects.contains(Effects::TEXTURES),
+            tangent_frames: geometry.tangent_frames,
             lights: !scene.lights.is_empty(),
             area_lights: modules.area_lights,
             environment: modules.environment,
@@ -66,6 +70,7 @@ impl Features {
             "INSTANCES" => self.instances,
             "SPHERES" => self.spheres,
             "TEXTURES" => self.textures,
+            "TANGENT_FRAMES" => self.tangent_frames,
             "LIGHTS" => self.lights,
             "AREA_LIGHTS" => self.area_lights,
             "ENVIRONMENT" => self.environment,
@@ -81,6 +86,7 @@ impl Features {
             ("instances", self.instances),
             ("spheres", self.spheres),
             ("textures", self.textures),
+            ("tangent frames", self.tangent_frames),
             ("next-event estimation", self.lights),
             ("area lights", self.area_lights),
             ("environment", self.environment),

@@ -118,7 +118,7 @@ impl Modules {
         m.filter_table(scene.filter.as_ref());
         m.splat_table(scene.filter.as_ref());
         m.materials(scene)?;
-        m.textures(&scene.textures)?;
+        m.textures(&scene.textures, &scene.texture_names)?;
         m.lights(scene)?;
         Ok(m)
     }
@@ -192,8 +192,13 @@ impl Modules {
         Ok(())
     }
 
-    /// The textures' directory: (type, offset, 0, 0) per texture.
-    fn textures(&mut self, textures: &TextureTable) -> Result<(), GpuError> {
+    /// The textures' directory: (type, offset, 0, 0) per texture;
+    /// `names` (the named textures) name one without GPU code.
+    fn textures(
+        &mut self,
+        textures: &TextureTable,
+        names: &[(TextureId, String, String)],
+    ) -> Result<(), GpuError> {
         let constant = GpuModule::new("constant", CONSTANT_TEXTURE, Default::default());
         let mut entries = Vec::with_capacity(4 * textures.len());
         for i in 0..textures.len() as u32 {
@@ -202,10 +207,17 @@ impl Modules {
                     params: radiant_core::GpuParams::new().rgb(c),
                     ..constant.clone()
                 },
-                TextureRef::Module(t) => t.gpu().ok_or_else(|| GpuError::MissingCode {
-                    kind: "texture",
-                    name: format!("#{i}"),
-                    type_name: "(a texture module)".into(),
+                TextureRef::Module(t) => t.gpu().ok_or_else(|| {
+                    let named = names.iter().find(|(id, ..)| id.0 == i);
+                    let (name, type_name) = named.map_or_else(
+                        || (format!("#{i}, written inline,"), "unrecorded".into()),
+                        |(_, name, ty)| (name.clone(), ty.clone()),
+                    );
+                    GpuError::MissingCode {
+                        kind: "texture",
+                        name,
+                        type_name,
+                    }
                 })?,
             };
             let tag = self.textures.tag(&module);
@@ -273,7 +285,7 @@ impl Modules {
             params: vec![0; HEADER_WORDS],
             ..Modules::default()
         };
-        m.textures(textures)?;
+        m.textures(textures, &[])?;
         let at = m.push(module);
         use super::probe::ProbeKind;
         let types = match kind {

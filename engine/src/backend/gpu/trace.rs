@@ -34,6 +34,7 @@ impl GpuBackend {
         let features = Features {
             instances: g.instanced,
             spheres: g.spheres,
+            tangent_frames: g.tangent_frames,
             ..Features::default()
         };
         let kernel = Kernel::assemble_trace(features);

@@ -13,6 +13,7 @@ use crate::accel::{Place, Primitive};
 use crate::extract::{NO_EMITTER, NO_MATERIAL, RenderScene};
 use glam::Vec3A;
 use obvhs::aabb::Aabb;
+use radiant_core::Effects;
 
 /// A `vec4f` of a storage buffer.
 pub type Vec4 = [f32; 4];
@@ -24,10 +25,15 @@ pub struct Geometry {
     pub nodes: Vec<Node>,
     /// Primitives, four `vec4f` each.
     pub prims: Vec<Vec4>,
-    /// Shading data, four `vec4f` per primitive in the CPU's numbering
-    /// (vertex normals with the texture coordinates in their `w`s; for
+    /// Shading data, [`Self::shading_rows`] `vec4f` per primitive in the
+    /// CPU's numbering (vertex normals with the texture coordinates in
+    /// their `w`s, then with tangent frames the vertex tangents; for
     /// spheres, the rows of the rotation to the sphere's object space).
     pub shading: Vec<Vec4>,
+    /// Whether shading frames are oriented by the surfaces'
+    /// parametrizations (the frame's effects contain `TANGENT_FRAMES`),
+    /// which adds the vertex tangents to the shading data.
+    pub tangent_frames: bool,
     /// Instances, ten `vec4f` each (empty without a top level).
     pub instances: Vec<Vec4>,
     /// The root rays start from: the top level, or the one bottom level.
@@ -51,14 +57,24 @@ fn box_of(p: &Primitive) -> Option<Aabb> {
 }
 
 impl Geometry {
+    /// `vec4f` rows of shading data per primitive (`SHADING_ROWS` in
+    /// `geometry.wgsl`).
+    pub fn shading_rows(&self) -> usize {
+        if self.tangent_frames { 7 } else { 4 }
+    }
+
     /// Lays out the geometry of `scene`. Motion while the shutter is open
     /// has no GPU code yet: such scenes are refused.
     pub fn new(scene: &RenderScene) -> Result<Self, GpuError> {
         let accel = &scene.accel;
         let surfaces = &scene.surfaces;
-        let mut g = Geometry::default();
+        let mut g = Geometry {
+            tangent_frames: scene.effects.contains(Effects::TANGENT_FRAMES),
+            ..Geometry::default()
+        };
+        let rows = g.shading_rows();
         let total: usize = accel.blases().iter().map(|b| b.len()).sum();
-        g.shading = vec![[0.0; 4]; 4 * total];
+        g.shading = vec![[0.0; 4]; rows * total];
         let mut roots = Vec::with_capacity(accel.blases().len());
         for (b, blas) in accel.blases().iter().enumerate() {
             if blas.deforms() {
@@ -97,12 +113,16 @@ impl Geometry {
                 ]);
                 let n = surfaces.normals[k];
                 let uv = surfaces.uvs.get(k).copied().unwrap_or_default();
-                g.shading[4 * k..4 * k + 4].copy_from_slice(&[
+                let row = &mut g.shading[rows * k..rows * (k + 1)];
+                row[..4].copy_from_slice(&[
                     vec4(n[0], uv[0].x),
                     vec4(n[1], uv[0].y),
                     vec4(n[2], uv[1].x),
                     [uv[1].y, uv[2].x, uv[2].y, 0.0],
                 ]);
+                if let Some(t) = surfaces.tangents.get(k).filter(|_| rows > 4) {
+                    row[4..].copy_from_slice(&t.map(|t| vec4(t, 0.0)));
+                }
             }
         }
         let instances = accel.instances();

@@ -6,10 +6,16 @@ const PI: f32 = 3.14159265358979323846;
 const INV_PI: f32 = 0.31830988618379067154;
 const FLOAT_MAX: f32 = 3.40282347e38;
 
-// A surface point as a shader sees it (local shading frame: +z normal).
+// A surface point as a shader sees it (local shading frame: +z normal),
+// with the surface's ∂p/∂u and ∂p/∂v in that frame: their real lengths
+// where the kernel has tangent frames (a material declared
+// `Effects::TANGENT_FRAMES`), else the frame's unit tangents (1, 0, 0) and
+// (0, 1, 0), as `SurfaceBatch` gives them on the CPU.
 struct ShadingPoint {
     wo: vec3f,
     uv: vec2f,
+    dp_du: vec3f,
+    dp_dv: vec3f,
 }
 
 // f·|cos θi|/pdf of a sampled incident direction (zero weight: failed).
@@ -49,6 +55,43 @@ struct CameraRay {
     origin: vec3f,
     dir: vec3f,
     weight: f32,
+}
+
+// `radiant_core::Frame` as the columns (s, t, n) of a matrix.
+
+// `Frame::from_normal`: Duff et al.'s frame around the unit vector n.
+fn frame_from_normal(n: vec3f) -> mat3x3f {
+    let sgn = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (sgn + n.z);
+    let b = n.x * n.y * a;
+    let s = vec3f(1.0 + sgn * n.x * n.x * a, sgn * b, -sgn * n.x);
+    let t = vec3f(b, sgn + n.y * n.y * a, -n.y);
+    return mat3x3f(s, t, n);
+}
+
+// `Frame::with_tangent`: the frame around the unit vector n whose tangent
+// is s made orthogonal to n; all zeros where s is zero, not finite or
+// (nearly) parallel to n (test with `frame_usable`).
+fn frame_with_tangent(n: vec3f, s: vec3f) -> mat3x3f {
+    let perp = s - n * dot(n, s);
+    let l2 = dot(perp, perp);
+    if !(l2 > 1e-10 * dot(s, s)) || !is_finite_f32(l2) {
+        return mat3x3f(vec3f(0.0), vec3f(0.0), vec3f(0.0));
+    }
+    let t = perp / sqrt(l2);
+    return mat3x3f(t, cross(n, t), n);
+}
+
+fn frame_usable(f: mat3x3f) -> bool {
+    return any(f[2] != vec3f(0.0));
+}
+
+fn frame_to_local(f: mat3x3f, v: vec3f) -> vec3f {
+    return vec3f(dot(v, f[0]), dot(v, f[1]), dot(v, f[2]));
+}
+
+fn frame_to_world(f: mat3x3f, v: vec3f) -> vec3f {
+    return f[0] * v.x + f[1] * v.y + f[2] * v.z;
 }
 
 fn bsdf_sample_failed() -> BsdfSample {

@@ -337,26 +337,25 @@ struct Interaction {
     // Shading frame: s, t, n.
     frame: mat3x3f,
     uv: vec2f,
+    // ∂p/∂u and ∂p/∂v with their real lengths under TANGENT_FRAMES, else
+    // the frame's s and t.
+    dp_du: vec3f,
+    dp_dv: vec3f,
     material: u32,
     emitter: u32,
     emitter_prim: u32,
 }
 
-fn shading_frame(n: vec3f) -> mat3x3f {
-    let sgn = select(-1.0, 1.0, n.z >= 0.0);
-    let a = -1.0 / (sgn + n.z);
-    let b = n.x * n.y * a;
-    let s = vec3f(1.0 + sgn * n.x * n.x * a, sgn * b, -sgn * n.x);
-    let t = vec3f(b, sgn + n.y * n.y * a, -n.y);
-    return mat3x3f(s, t, n);
-}
+// Rows of shading data per primitive: vertex normals and texture
+// coordinates, then (TANGENT_FRAMES) the MikkTSpace vertex tangents.
+//#if TANGENT_FRAMES
+const SHADING_ROWS: u32 = 7u;
+//#else
+const SHADING_ROWS: u32 = 4u;
+//#endif
 
-fn to_local(f: mat3x3f, v: vec3f) -> vec3f {
-    return vec3f(dot(v, f[0]), dot(v, f[1]), dot(v, f[2]));
-}
-
-fn to_world(f: mat3x3f, v: vec3f) -> vec3f {
-    return f[0] * v.x + f[1] * v.y + f[2] * v.z;
+fn shading_row(sh: u32, row: u32) -> vec4f {
+    return shading[SHADING_ROWS * sh + row];
 }
 
 // Shading normal bent above the geometric tangent plane (surface.rs).
@@ -367,6 +366,91 @@ fn above_tangent_plane(ns: vec3f, ng: vec3f) -> vec3f {
     }
     return normalize(ns + ng * (0.01 - c));
 }
+
+// The frame's unit tangents as the derivatives of a surface without them.
+fn set_unit_derivatives(it: ptr<function, Interaction>) {
+    (*it).dp_du = (*it).frame[0];
+    (*it).dp_dv = (*it).frame[1];
+}
+
+//#if TANGENT_FRAMES
+// `Frame::around_z`: the tangent along ẑ × n, or the x axis made
+// orthogonal to n near ±z.
+fn frame_around_z(n: vec3f) -> mat3x3f {
+    if n.x * n.x + n.y * n.y > 1e-6 {
+        let f = frame_with_tangent(n, vec3f(-n.y, n.x, 0.0));
+        if frame_usable(f) {
+            return f;
+        }
+    }
+    let f = frame_with_tangent(n, vec3f(1.0, 0.0, 0.0));
+    if frame_usable(f) {
+        return f;
+    }
+    return frame_from_normal(n);
+}
+
+// surface.rs `triangle_frame`: the frame around ns oriented by the
+// interpolated vertex tangent, else by ∂p/∂u of the texture coordinates,
+// else around z; with the triangle's derivatives (the frame's unit
+// tangents where the coordinates give none).
+fn triangle_frame(it: ptr<function, Interaction>, ns: vec3f, v0: vec3f, v1: vec3f, v2: vec3f, uv0: vec2f, uv1: vec2f, uv2: vec2f, tangent: vec3f) {
+    let uvless = all(uv0 == vec2f(0.0, 0.0)) && all(uv1 == vec2f(1.0, 0.0)) && all(uv2 == vec2f(0.0, 1.0))
+        && all(tangent == vec3f(0.0));
+    var has_dp = false;
+    var dp_du = vec3f(0.0);
+    var dp_dv = vec3f(0.0);
+    if !uvless {
+        let dp0 = v1 - v0;
+        let dp1 = v2 - v0;
+        let duv0 = uv1 - uv0;
+        let duv1 = uv2 - uv0;
+        let det = duv0.x * duv1.y - duv0.y * duv1.x;
+        if abs(det) > 1e-9 * length(duv0) * length(duv1) {
+            let inv = 1.0 / det;
+            dp_du = (dp0 * duv1.y - dp1 * duv0.y) * inv;
+            dp_dv = (dp1 * duv0.x - dp0 * duv1.x) * inv;
+            has_dp = is_finite_vec3(dp_du) && is_finite_vec3(dp_dv);
+        }
+    }
+    var f = frame_with_tangent(ns, tangent);
+    if !frame_usable(f) && has_dp {
+        f = frame_with_tangent(ns, dp_du);
+    }
+    if !frame_usable(f) {
+        f = frame_around_z(ns);
+    }
+    (*it).frame = f;
+    if has_dp {
+        (*it).dp_du = dp_du;
+        (*it).dp_dv = dp_dv;
+    } else {
+        set_unit_derivatives(it);
+    }
+}
+
+// surface.rs `sphere_frame`: Mitsuba 3's u = φ/2π, v = θ/π in the
+// sphere's own axes (`rows`: the rotation into them), n in those axes
+// being `local`.
+fn sphere_frame(it: ptr<function, Interaction>, n: vec3f, local: vec3f, r0: vec3f, r1: vec3f, r2: vec3f, radius: f32) {
+    let rd = sqrt(local.x * local.x + local.y * local.y);
+    var dv = vec3f(1.0, 0.0, 0.0);
+    if rd > 0.0 {
+        dv = vec3f(local.z * local.x / rd, local.z * local.y / rd, -rd);
+    }
+    let du = vec3f(-local.y, local.x, 0.0);
+    (*it).dp_du = (r0 * du.x + r1 * du.y + r2 * du.z) * (2.0 * PI * radius);
+    (*it).dp_dv = (r0 * dv.x + r1 * dv.y + r2 * dv.z) * (PI * radius);
+    var f = frame_with_tangent(n, (*it).dp_du);
+    if !frame_usable(f) {
+        f = frame_with_tangent(n, r1);
+    }
+    if !frame_usable(f) {
+        f = frame_around_z(n);
+    }
+    (*it).frame = f;
+}
+//#endif
 
 // The interaction in the primitive's own space.
 fn local_interaction(hit: Hit, o: vec3f, d: vec3f) -> Interaction {
@@ -385,10 +469,19 @@ fn local_interaction(hit: Hit, o: vec3f, d: vec3f) -> Interaction {
         it.p = c + n * r;
         it.err = (abs(it.p) + abs(c)) * GAMMA5;
         it.ng = n;
-        it.frame = shading_frame(n);
+        // The rows of the rotation into the sphere's own axes.
+        let r0 = shading_row(sh, 0u).xyz;
+        let r1 = shading_row(sh, 1u).xyz;
+        let r2 = shading_row(sh, 2u).xyz;
+        let local = vec3f(dot(r0, n), dot(r1, n), dot(r2, n));
 //#if TEXTURES
-        let local = vec3f(dot(shading[4u * sh].xyz, n), dot(shading[4u * sh + 1u].xyz, n), dot(shading[4u * sh + 2u].xyz, n));
         it.uv = vec2f(fract(atan2(local.y, local.x) * INV_PI * 0.5 + 1.0), acos(clamp(local.z, -1.0, 1.0)) * INV_PI);
+//#endif
+//#if TANGENT_FRAMES
+        sphere_frame(&it, n, local, r0, r1, r2, r);
+//#else
+        it.frame = frame_from_normal(n);
+        set_unit_derivatives(&it);
 //#endif
         return it;
     }
@@ -405,9 +498,9 @@ fn local_interaction(hit: Hit, o: vec3f, d: vec3f) -> Interaction {
     let ng = normalize(cross(v1 - v0, v2 - v0));
     it.ng = ng;
     var ns = ng;
-    let n0 = shading[4u * sh];
-    let n1 = shading[4u * sh + 1u];
-    let n2 = shading[4u * sh + 2u];
+    let n0 = shading_row(sh, 0u);
+    let n1 = shading_row(sh, 1u);
+    let n2 = shading_row(sh, 2u);
     if any(n0.xyz != vec3f(0.0)) {
         let sum = n0.xyz * b.x + n1.xyz * b.y + n2.xyz * b.z;
         let l = length(sum);
@@ -417,10 +510,19 @@ fn local_interaction(hit: Hit, o: vec3f, d: vec3f) -> Interaction {
             ns = above_tangent_plane(ng, ng);
         }
     }
-    it.frame = shading_frame(ns);
+    let uv3 = shading_row(sh, 3u);
+    let uv0 = vec2f(n0.w, n1.w);
+    let uv1 = vec2f(n2.w, uv3.x);
+    let uv2 = uv3.yz;
 //#if TEXTURES
-    let uv3 = shading[4u * sh + 3u];
-    it.uv = vec2f(n0.w, n1.w) * b.x + vec2f(n2.w, uv3.x) * b.y + uv3.yz * b.z;
+    it.uv = uv0 * b.x + uv1 * b.y + uv2 * b.z;
+//#endif
+//#if TANGENT_FRAMES
+    let tangent = shading_row(sh, 4u).xyz * b.x + shading_row(sh, 5u).xyz * b.y + shading_row(sh, 6u).xyz * b.z;
+    triangle_frame(&it, ns, v0, v1, v2, uv0, uv1, uv2, tangent);
+//#else
+    it.frame = frame_from_normal(ns);
+    set_unit_derivatives(&it);
 //#endif
     return it;
 }
@@ -442,8 +544,18 @@ fn interaction(hit: Hit, o: vec3f, d: vec3f) -> Interaction {
     it.err = affine_abs_vector(inst, 6u, it.err) * (GAMMA3 + 1.0)
         + (affine_abs_vector(inst, 6u, abs(p)) + translation) * GAMMA3;
     it.ng = normalize(affine_vector(inst, 3u, it.ng));
-    var ns = normalize(affine_vector(inst, 3u, it.frame[2]));
-    it.frame = shading_frame(above_tangent_plane(ns, it.ng));
+    let ns = above_tangent_plane(normalize(affine_vector(inst, 3u, it.frame[2])), it.ng);
+//#if TANGENT_FRAMES
+    it.dp_du = affine_vector(inst, 6u, it.dp_du);
+    it.dp_dv = affine_vector(inst, 6u, it.dp_dv);
+    it.frame = frame_with_tangent(ns, affine_vector(inst, 6u, it.frame[0]));
+    if !frame_usable(it.frame) {
+        it.frame = frame_around_z(ns);
+    }
+//#else
+    it.frame = frame_from_normal(ns);
+    set_unit_derivatives(&it);
+//#endif
     return it;
 //#else
     return local_interaction(hit, o, d);

@@ -183,7 +183,7 @@ fn trace_path(px: u32, py: u32, index: u32, rays: ptr<function, u32>, shadow_ray
             break;
         }
         let base = CAMERA_DIMS + depth * BOUNCE_DIMS;
-        let sp = ShadingPoint(to_local(it.frame, -d), it.uv);
+        let sp = ShadingPoint(frame_to_local(it.frame, -d), it.uv, frame_to_local(it.frame, it.dp_du), frame_to_local(it.frame, it.dp_dv));
         let material = it.material;
 //#if LIGHTS
         // Next-event estimation: a light in proportion to power, a point
@@ -202,7 +202,7 @@ fn trace_path(px: u32, py: u32, index: u32, rays: ptr<function, u32>, shadow_ray
         if to_light_len > 0.0 {
             wi_world = to_light / to_light_len;
         }
-        let wi_local = to_local(it.frame, wi_world);
+        let wi_local = frame_to_local(it.frame, wi_world);
         if ls.pdf > 0.0 && material_has_smooth_lobes(material)
             && dot(wi_world, it.ng) * wi_local.z > 0.0 {
             let e = bsdf_eval(material, sp, wi_local);
@@ -232,7 +232,7 @@ fn trace_path(px: u32, py: u32, index: u32, rays: ptr<function, u32>, shadow_ray
         if bs.pdf <= 0.0 || all(bs.weight == vec3f(0.0)) {
             break;
         }
-        let wi = to_world(it.frame, bs.wi);
+        let wi = frame_to_world(it.frame, bs.wi);
         if dot(wi, it.ng) * bs.wi.z <= 0.0 {
             break;
         }
