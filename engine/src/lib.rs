@@ -28,6 +28,7 @@ pub mod backend;
 pub mod compare;
 pub mod error;
 pub mod extract;
+pub mod farm;
 pub mod film;
 pub mod integrators;
 pub mod scene;

@@ -8,8 +8,9 @@ pub mod cpu;
 pub mod gpu;
 
 use crate::extract::RenderScene;
-use crate::film::Image;
+use crate::film::{Film, Image};
 use crate::film::memory::FrameTooLarge;
+use std::ops::Range;
 use std::time::Duration;
 use thiserror::Error;
 
@@ -79,6 +80,16 @@ pub trait Backend: Send {
         progress: &Progress<'_>,
     ) -> Result<Rendered, RenderError>;
 
+    /// Renders the sample indices `samples` of every pixel and adds them
+    /// to `film` (one sample partition of a frame, or a progressive pass).
+    fn render_samples(
+        &mut self,
+        scene: &RenderScene,
+        film: &mut Film,
+        samples: Range<u32>,
+        progress: &Progress<'_>,
+    ) -> Result<cpu::Pass, RenderError>;
+
     /// What the last render counted beyond [`Rendered`], as a line for
     /// the user (the GPU's rays by kind and traversal work), if anything.
     fn counts(&self) -> Option<String> {
@@ -102,6 +113,16 @@ impl Backend for CpuBackend {
     ) -> Result<Rendered, RenderError> {
         Ok(cpu::try_render(scene, progress)?)
     }
+
+    fn render_samples(
+        &mut self,
+        scene: &RenderScene,
+        film: &mut Film,
+        samples: Range<u32>,
+        progress: &Progress<'_>,
+    ) -> Result<cpu::Pass, RenderError> {
+        Ok(cpu::render_samples(scene, film, samples, progress))
+    }
 }
 
 impl Backend for gpu::GpuBackend {
@@ -115,6 +136,18 @@ impl Backend for gpu::GpuBackend {
         progress: &Progress<'_>,
     ) -> Result<Rendered, RenderError> {
         Ok(gpu::GpuBackend::render(self, scene, progress)?)
+    }
+
+    fn render_samples(
+        &mut self,
+        scene: &RenderScene,
+        film: &mut Film,
+        samples: Range<u32>,
+        progress: &Progress<'_>,
+    ) -> Result<cpu::Pass, RenderError> {
+        Ok(gpu::GpuBackend::render_samples(
+            self, scene, film, samples, progress,
+        )?)
     }
 
     fn counts(&self) -> Option<String> {

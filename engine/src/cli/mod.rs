@@ -2,10 +2,13 @@
 
 mod accuracy;
 mod diagnostic;
+mod farm;
 mod film_args;
 mod info;
+mod merge;
 mod modules;
 mod render;
+mod sampling_args;
 mod sheet;
 
 use clap::{Parser, Subcommand};
@@ -32,6 +35,11 @@ enum Command {
     Modules,
     /// Show rendered frames as a contact sheet (.png) or an animated GIF (.gif).
     Sheet(sheet::SheetArgs),
+    /// Add the partial EXR files of a frame's sample partitions into the frame.
+    Merge(merge::MergeArgs),
+    /// Render on a cluster: Slurm job scripts, and the state of a sequence.
+    #[command(subcommand)]
+    Farm(farm::FarmCommand),
     /// Compare an image against a reference (RMSE, relative MSE, mean ratio).
     Compare {
         /// The image to judge (EXR).
@@ -56,6 +64,8 @@ pub fn run() -> ExitCode {
         Command::Accuracy(args) => accuracy::run(&registry, &args),
         Command::Info(args) => info::run(&registry, &args),
         Command::Sheet(args) => sheet::run(&args),
+        Command::Merge(args) => merge::run(&args),
+        Command::Farm(command) => farm::run(&command),
         Command::Modules => {
             modules::run(&registry);
             Ok(())

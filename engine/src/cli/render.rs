@@ -1,13 +1,17 @@
 //! `radiant render`: render a scene, or a range of its frames, to image
 //! files.
 
+mod partition;
+
 use super::diagnostic::report;
 use super::film_args::FilmArgs;
+use super::sampling_args::SamplingArgs;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use radiant::Registry;
 use radiant::backend::{Backend, BackendKind, Progress, choose};
-use radiant::extract::{Overrides, Sequence, SequenceOptions};
+use radiant::extract::{Sequence, SequenceOptions};
+use radiant::world::Timeline;
 use radiant::world::systems::substitute_frame;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -35,15 +39,8 @@ pub struct RenderArgs {
     /// for A/B comparisons) instead of one seed per frame.
     #[arg(long)]
     lock_noise: bool,
-    /// Samples per pixel, at least 1 (overrides the scene's sampler).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
-    spp: Option<u32>,
-    /// Longest path in segments; -1 for unlimited (overrides the scene).
-    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(i32).range(-1..))]
-    max_depth: Option<i32>,
-    /// Sampler seed (of the scene's first frame; the others derive theirs).
-    #[arg(long)]
-    seed: Option<u64>,
+    #[command(flatten)]
+    sampling: SamplingArgs,
     /// Which backend renders: `gpu` (fails where there is no adapter or a
     /// module lacks GPU code), `cpu`, or `auto` (the GPU where a hardware
     /// adapter can render the scene, else the CPU; says which on stderr).
@@ -53,6 +50,10 @@ pub struct RenderArgs {
     /// tested per ray; slows rendering) and print the rays by kind.
     #[arg(long)]
     gpu_stats: bool,
+    /// Render only the K-th of N disjoint sample partitions of one frame
+    /// (`3/16`) into a partial EXR file for `radiant merge`.
+    #[arg(long, value_parser = clap::value_parser!(radiant::farm::partition::Partition))]
+    partition: Option<radiant::farm::partition::Partition>,
     #[command(flatten)]
     film: FilmArgs,
 }
@@ -81,7 +82,7 @@ pub fn parse_frames(text: &str) -> Result<(i64, i64), String> {
 
 /// Checks that `output` can be written: a .png or .exr name in a folder
 /// that exists.
-fn check_output(output: &Path) -> miette::Result<()> {
+pub(super) fn check_output(output: &Path) -> miette::Result<()> {
     let ext = output
         .extension()
         .and_then(|e| e.to_str())
@@ -114,6 +115,23 @@ fn check_output(output: &Path) -> miette::Result<()> {
     Ok(())
 }
 
+/// Checks that the frames `first..=last` are among the scene's.
+pub(super) fn check_frames(
+    scene: &Path,
+    timeline: &Timeline,
+    (first, last): (i64, i64),
+) -> miette::Result<()> {
+    if !(timeline.contains(first) && timeline.contains(last)) {
+        miette::bail!(
+            "frames {first}..{last} are outside the scene's frames {}..{} (`animation: {{frames: [first, last]}}` in `{}` sets them)",
+            timeline.start,
+            timeline.end,
+            scene.display()
+        );
+    }
+    Ok(())
+}
+
 /// The output file of `frame`.
 pub(super) fn frame_path(output: &Path, frame: i64) -> PathBuf {
     let name = output
@@ -135,19 +153,15 @@ struct Totals {
 
 /// Renders as the arguments say.
 pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
+    if let Some(p) = args.partition {
+        return partition::run(registry, args, p);
+    }
     let pattern = args.output.to_string_lossy().contains('#');
     check_output(&frame_path(&args.output, 0))?;
     let mut scene = radiant::scene::load(&args.scene).map_err(report)?;
     let timeline = scene.timeline;
     let (first, last) = args.frames.unwrap_or((timeline.start, timeline.start));
-    if !(timeline.contains(first) && timeline.contains(last)) {
-        miette::bail!(
-            "frames {first}..{last} are outside the scene's frames {}..{} (`animation: {{frames: [first, last]}}` in `{}` sets them)",
-            timeline.start,
-            timeline.end,
-            args.scene.display()
-        );
-    }
+    check_frames(&args.scene, &timeline, (first, last))?;
     let sequence = args.frames.is_some();
     if last > first && !pattern {
         miette::bail!(
@@ -156,14 +170,7 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
             args.output.display()
         );
     }
-    let overrides = Overrides {
-        spp: args.spp,
-        max_depth: args.max_depth,
-        seed: args.seed,
-        width: args.film.width,
-        height: args.film.height,
-        ..Default::default()
-    };
+    let overrides = args.sampling.overrides(&args.film);
     let options = SequenceOptions {
         lock_noise: args.lock_noise,
         ..SequenceOptions::default()

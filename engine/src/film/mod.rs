@@ -326,6 +326,12 @@ impl Film {
         self.invalid_samples += invalid;
     }
 
+    /// The per-pixel sums (Σ w·L in RGB, Σ w in alpha), row-major: what a
+    /// sample partition stores for `radiant merge` to add.
+    pub fn sums(&self) -> &[Vec4] {
+        &self.sums
+    }
+
     /// Adds a tile's sums.
     pub fn merge(&mut self, tile: &TileFilm) {
         for y in 0..tile.height {
