@@ -189,6 +189,13 @@ fn bad_merges_name_the_files_and_write_nothing() {
     let bytes = std::fs::read(&parts[3]).unwrap();
     std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
     refused(&with(&cut), &[format!("cannot read {}", name(&cut))]);
+    // An output that cannot be written is refused before any reading.
+    let o = merge(&parts, &dir.path().join("merged.bmp"));
+    assert!(
+        stderr(&o).contains("must end in .png or .exr"),
+        "{}",
+        stderr(&o)
+    );
     // And what was whole still merges.
     let o = merge(&parts, &dir.path().join("merged.exr"));
     assert!(o.status.success(), "{}", stderr(&o));

@@ -2,6 +2,7 @@
 //! partitions into the frame (`radiant::farm::merge`) and writes it as
 //! `radiant render` writes images (atomically; nothing on an error).
 
+use super::render::check_output;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -19,6 +20,7 @@ pub struct MergeArgs {
 
 /// Merges as the arguments say.
 pub fn run(args: &MergeArgs) -> miette::Result<()> {
+    check_output(&args.output)?;
     let (film, header) =
         radiant::farm::merge::merge(&args.inputs).map_err(|e| miette::miette!("{e}"))?;
     let image = film.try_develop().map_err(|e| miette::miette!("{e}"))?;
