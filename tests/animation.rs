@@ -6,6 +6,7 @@ use radiant::backend::cpu::{Progress, render};
 use radiant::extract::{Overrides, Sequence, SequenceOptions};
 use radiant::film::Image;
 use radiant::scene::{SceneError, from_str};
+use radiant_tests::write_grid;
 use std::path::Path;
 
 /// A small Cornell-like room with an animated cube, an animated colour, a
@@ -170,39 +171,6 @@ fn animated_parameters_and_instance_materials_reach_the_image() {
     assert!(last[2] > last[0], "{last:?}");
     let total = |m: [f64; 3]| m.iter().sum::<f64>();
     assert!(total(last) > 1.3 * total(first), "{first:?} → {last:?}");
-}
-
-/// Writes an OBJ grid of `n`×`n` vertices rippled by `phase`.
-fn write_grid(path: &Path, n: usize, phase: f32, drop_face: bool) {
-    let mut text = String::new();
-    for j in 0..n {
-        for i in 0..n {
-            let (x, y) = (
-                i as f32 / (n - 1) as f32 * 2.0 - 1.0,
-                j as f32 / (n - 1) as f32 * 2.0 - 1.0,
-            );
-            let z = 0.2 * (3.0 * x + phase).sin();
-            text.push_str(&format!("v {x} {y} {z}\n"));
-        }
-    }
-    for j in 0..n - 1 {
-        for i in 0..n - 1 {
-            if drop_face && i == 0 && j == 0 {
-                continue;
-            }
-            let a = j * n + i + 1;
-            text.push_str(&format!(
-                "f {} {} {}\nf {} {} {}\n",
-                a,
-                a + 1,
-                a + n + 1,
-                a,
-                a + n + 1,
-                a + n
-            ));
-        }
-    }
-    std::fs::write(path, text).expect("temporary files are writable");
 }
 
 fn mesh_scene(pattern: &str, shutter: &str) -> String {

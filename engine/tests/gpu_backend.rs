@@ -54,7 +54,7 @@ fn geometry_scene_with(pebbles: bool, bricks: bool) -> RenderScene {
 /// Random rays from inside the box in every direction, with occlusion
 /// distances from 0.05 to 3. (Render space has the camera, 3.9 in front of
 /// the box's centre, at its origin.)
-fn rays(n: usize) -> Vec<(Vec3, Vec3, f32)> {
+fn rays(n: usize) -> Vec<(Vec3, Vec3, f32, f32)> {
     let mut state = 0x2545_f491_4f6c_dd1du64;
     let mut next = move || {
         state ^= state << 13;
@@ -69,7 +69,7 @@ fn rays(n: usize) -> Vec<(Vec3, Vec3, f32)> {
             let r = (1.0 - z * z).max(0.0).sqrt();
             let phi = std::f32::consts::TAU * next();
             let d = Vec3::new(r * phi.cos(), r * phi.sin(), z);
-            (o, d, 0.05 + 2.95 * next())
+            (o, d, 0.05 + 2.95 * next(), 0.0)
         })
         .collect()
 }
@@ -82,7 +82,7 @@ fn traversal_agrees(instanced: bool) {
     let rays = rays(20_000);
     let gpu = backend().trace_rays(&scene, &rays).unwrap();
     let (mut prim_mismatch, mut t_mismatch, mut occlusion_mismatch, mut hits) = (0, 0, 0, 0);
-    for ((o, d, tmax), g) in rays.iter().zip(&gpu) {
+    for ((o, d, tmax, _), g) in rays.iter().zip(&gpu) {
         let cpu = scene.accel.intersect(*o, *d, f32::INFINITY);
         match cpu {
             Some(h) => {

@@ -173,6 +173,41 @@ pub fn check_against(image: &Image, reference: &Image, block: u32) -> ReferenceC
     }
 }
 
+/// Writes an OBJ grid of `n`×`n` vertices over [−1, 1]² rippled by
+/// `phase` (z = 0.2·sin(3x + phase)), without its first face where
+/// `drop_face` (a changed topology): one frame of a deforming mesh.
+pub fn write_grid(path: &std::path::Path, n: usize, phase: f32, drop_face: bool) {
+    let mut text = String::new();
+    for j in 0..n {
+        for i in 0..n {
+            let (x, y) = (
+                i as f32 / (n - 1) as f32 * 2.0 - 1.0,
+                j as f32 / (n - 1) as f32 * 2.0 - 1.0,
+            );
+            let z = 0.2 * (3.0 * x + phase).sin();
+            text.push_str(&format!("v {x} {y} {z}\n"));
+        }
+    }
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            if drop_face && i == 0 && j == 0 {
+                continue;
+            }
+            let a = j * n + i + 1;
+            text.push_str(&format!(
+                "f {} {} {}\nf {} {} {}\n",
+                a,
+                a + 1,
+                a + n + 1,
+                a,
+                a + n + 1,
+                a + n
+            ));
+        }
+    }
+    std::fs::write(path, text).expect("temporary files are writable");
+}
+
 pub mod chi2;
 pub mod gpu;
 pub mod shading;

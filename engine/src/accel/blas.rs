@@ -161,6 +161,12 @@ impl Blas {
         self.hierarchy.wide.cover()
     }
 
+    /// The primitives at shutter close (leaf order), for geometry that
+    /// deforms while the shutter is open.
+    pub fn closing_primitives(&self) -> Option<&[Primitive]> {
+        self.closing.as_ref().map(|c| &c.prims[..])
+    }
+
     /// Primitive `i` (leaf order) at shutter time `tau` (triangles of a
     /// deforming mesh are interpolated vertex by vertex).
     #[inline]

@@ -45,11 +45,6 @@ pub enum GpuError {
         /// The module type.
         type_name: String,
     },
-    /// A feature of the scene has no GPU code yet.
-    #[error(
-        "the scene uses {0}, which the GPU backend cannot render yet; render it with `--backend cpu` (or `auto`)"
-    )]
-    Unsupported(String),
     /// The generated kernel did not compile.
     #[error("the GPU kernel did not compile{}: {message}", module.as_ref().map(|m| format!(" (in the code of {m})")).unwrap_or_default())]
     Compile {

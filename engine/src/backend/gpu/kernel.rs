@@ -35,6 +35,9 @@ pub struct Features {
     /// Shading frames oriented by the surface's parametrization, with its
     /// derivatives (anisotropic lobes, normal and bump maps).
     pub tangent_frames: bool,
+    /// Rays that carry a time in the shutter (motion blur): moving
+    /// instances, deforming meshes, a moving camera.
+    pub motion: bool,
     /// Any light (next-event estimation).
     pub lights: bool,
     /// Surfaces that emit.
@@ -57,6 +60,7 @@ impl Features {
             spheres: geometry.spheres,
             textures: scene.effects.contains(Effects::TEXTURES),
             tangent_frames: geometry.tangent_frames,
+            motion: geometry.motion,
             lights: !scene.lights.is_empty(),
             area_lights: modules.area_lights,
             environment: modules.environment,
@@ -71,6 +75,7 @@ impl Features {
             "SPHERES" => self.spheres,
             "TEXTURES" => self.textures,
             "TANGENT_FRAMES" => self.tangent_frames,
+            "MOTION" => self.motion,
             "LIGHTS" => self.lights,
             "AREA_LIGHTS" => self.area_lights,
             "ENVIRONMENT" => self.environment,
@@ -87,6 +92,7 @@ impl Features {
             ("spheres", self.spheres),
             ("textures", self.textures),
             ("tangent frames", self.tangent_frames),
+            ("motion blur", self.motion),
             ("next-event estimation", self.lights),
             ("area lights", self.area_lights),
             ("environment", self.environment),
@@ -209,19 +215,25 @@ impl Kernel {
         );
         k.part(
             "the tracer",
-            "@compute @workgroup_size(64)\n\
+            &preprocess(
+                "@compute @workgroup_size(64)\n\
              fn trace(@builtin(global_invocation_id) g: vec3u) {\n\
              \x20   let i = g.x;\n\
              \x20   if i >= arrayLength(&rays) / 2u { return; }\n\
              \x20   let o = rays[2u * i].xyz;\n\
              \x20   let tmax = rays[2u * i].w;\n\
              \x20   let d = rays[2u * i + 1u].xyz;\n\
+             //#if MOTION\n\
+             \x20   ray_time = rays[2u * i + 1u].w;\n\
+             //#endif\n\
              \x20   let h = closest_hit(o, d);\n\
              \x20   var prim = 0xffffffffu;\n\
              \x20   if h.slot != NO_HIT { prim = prim_info(h.slot).w; }\n\
              \x20   let blocked = select(0.0, 1.0, occluded(o, d, tmax));\n\
              \x20   hits[i] = vec4f(h.t, bitcast<f32>(prim), blocked, 0.0);\n\
              }\n",
+                &features,
+            ),
         );
         k
     }

@@ -100,8 +100,9 @@ impl Plan {
     /// Plans `scene` for the GPU: fails, naming it, on a module without
     /// GPU code or a feature the backend lacks.
     pub fn new(scene: &RenderScene) -> Result<Self, GpuError> {
-        let modules = Modules::new(scene)?;
+        let mut modules = Modules::new(scene)?;
         let geometry = Geometry::new(scene)?;
+        modules.locate(&geometry);
         let features = Features::of(scene, &geometry, &modules);
         let kernel = Kernel::assemble(&modules, features);
         Ok(Self {

@@ -8,6 +8,7 @@
 //! it ([`GpuError::MissingCode`]).
 
 use super::error::GpuError;
+use super::upload::Geometry;
 use crate::extract::RenderScene;
 use radiant_core::{
     Effects, Filter, FilterSampler, GpuLibrary, GpuModule, TextureId, TextureRef, TextureTable,
@@ -18,7 +19,7 @@ const FILTER_RES: u32 = 64;
 
 /// Words of the header at the start of the parameter buffer (the `H_*`
 /// constants of `wgsl/path.wgsl`).
-const HEADER_WORDS: usize = 17;
+const HEADER_WORDS: usize = 18;
 
 /// One module type of a kind, as the kernel includes it.
 #[derive(Debug, Clone, PartialEq)]
@@ -270,6 +271,13 @@ impl Modules {
         self.params
             .extend(table.environment().iter().map(|&i| i as u32));
         Ok(())
+    }
+
+    /// Writes where `geometry`'s traversal starts and its camera motion
+    /// record into the header.
+    pub(super) fn locate(&mut self, geometry: &Geometry) {
+        self.params[0] = geometry.root;
+        self.params[17] = geometry.camera_motion;
     }
 
     /// The parameter block of a probe ([`super::probe`]): the header and

@@ -23,18 +23,19 @@ pub struct TracedRay {
 }
 
 impl GpuBackend {
-    /// Traces `rays` (origin, direction, tmax for the occlusion query)
-    /// through `scene`'s geometry.
+    /// Traces `rays` (origin, direction, tmax for the occlusion query,
+    /// time in the shutter) through `scene`'s geometry.
     pub fn trace_rays(
         &mut self,
         scene: &RenderScene,
-        rays: &[(Vec3, Vec3, f32)],
+        rays: &[(Vec3, Vec3, f32, f32)],
     ) -> Result<Vec<TracedRay>, GpuError> {
         let g = Geometry::new(scene)?;
         let features = Features {
             instances: g.instanced,
             spheres: g.spheres,
             tangent_frames: g.tangent_frames,
+            motion: g.motion,
             ..Features::default()
         };
         let kernel = Kernel::assemble_trace(features);
@@ -54,7 +55,7 @@ impl GpuBackend {
         });
         let packed: Vec<[f32; 4]> = rays
             .iter()
-            .flat_map(|(o, dir, tmax)| [[o.x, o.y, o.z, *tmax], [dir.x, dir.y, dir.z, 0.0]])
+            .flat_map(|(o, dir, tmax, tau)| [[o.x, o.y, o.z, *tmax], [dir.x, dir.y, dir.z, *tau]])
             .collect();
         let buffer = |label, data: &[u8], usage| {
             let padded = [data, &[0u8; 16]].concat();

@@ -1,6 +1,7 @@
 //! The frame's geometry in the GPU's layout: primitives in leaf order of
-//! per-mesh binary BVHs, their shading data beside them, instances, and
-//! the top level (see `wgsl/geometry.wgsl` for the layouts).
+//! per-mesh binary BVHs, their shading data beside them, instances, the
+//! motion of what moves while the shutter is open, and the top level (see
+//! `wgsl/geometry.wgsl` for the layouts).
 //!
 //! Primitive numbers stay those of the CPU's [`Accel`](crate::accel::Accel)
 //! (each bottom level's leaf order from its base), so the shading arrays
@@ -9,181 +10,264 @@
 
 use super::bvh::{Node, build_level};
 use super::error::GpuError;
-use crate::accel::{Place, Primitive};
+use crate::accel::{Motion, Place, Primitive};
 use crate::extract::{NO_EMITTER, NO_MATERIAL, RenderScene};
-use glam::Vec3A;
+use glam::{Affine3A, DMat4, Mat3A, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use radiant_core::Effects;
 
 /// A `vec4f` of a storage buffer.
 pub type Vec4 = [f32; 4];
 
+/// Rows of an instance record (`INSTANCE_ROWS` in `geometry.wgsl`).
+const INSTANCE_ROWS: usize = 10;
+
+/// "None" in a reference word (`NO_HIT` in `geometry.wgsl`).
+const NONE: u32 = u32::MAX;
+
 /// The frame's geometry, ready to upload.
 #[derive(Debug, Clone, Default)]
 pub struct Geometry {
     /// All hierarchies' nodes (bottom levels, then the top level).
     pub nodes: Vec<Node>,
-    /// Primitives, four `vec4f` each.
+    /// Primitives, [`Self::prim_rows`] `vec4f` each: the shape at shutter
+    /// open, its reference words, then under motion blur the shape at
+    /// shutter close.
     pub prims: Vec<Vec4>,
     /// Shading data, [`Self::shading_rows`] `vec4f` per primitive in the
     /// CPU's numbering (vertex normals with the texture coordinates in
     /// their `w`s, then with tangent frames the vertex tangents; for
     /// spheres, the rows of the rotation to the sphere's object space).
     pub shading: Vec<Vec4>,
-    /// Whether shading frames are oriented by the surfaces'
-    /// parametrizations (the frame's effects contain `TANGENT_FRAMES`),
-    /// which adds the vertex tangents to the shading data.
-    pub tangent_frames: bool,
-    /// Instances, ten `vec4f` each (empty without a top level).
+    /// Instances, ten `vec4f` each (empty without a top level), then the
+    /// motion records of moving instances and of a moving camera.
     pub instances: Vec<Vec4>,
     /// The root rays start from: the top level, or the one bottom level.
     pub root: u32,
+    /// The row of the camera's motion record in `instances` ([`u32::MAX`]
+    /// where the camera does not move while the shutter is open).
+    pub camera_motion: u32,
     /// Whether rays go through a top level of instances.
     pub instanced: bool,
     /// Whether any primitive is a sphere.
     pub spheres: bool,
+    /// Whether shading frames are oriented by the surfaces'
+    /// parametrizations (the frame's effects contain `TANGENT_FRAMES`),
+    /// which adds the vertex tangents to the shading data.
+    pub tangent_frames: bool,
+    /// Whether rays carry a time in the shutter (motion blur), which adds
+    /// the shapes at shutter close to the primitives.
+    pub motion: bool,
 }
 
-fn vec4(v: glam::Vec3, w: f32) -> Vec4 {
+fn vec4(v: Vec3, w: f32) -> Vec4 {
     [v.x, v.y, v.z, w]
 }
 
 fn box_of(p: &Primitive) -> Option<Aabb> {
     let (lo, hi) = match *p {
         Primitive::Triangle([a, b, c]) => (a.min(b).min(c), a.max(b).max(c)),
-        Primitive::Sphere(c, r) => (c - glam::Vec3::splat(r), c + glam::Vec3::splat(r)),
+        Primitive::Sphere(c, r) => (c - Vec3::splat(r), c + Vec3::splat(r)),
     };
     (lo.is_finite() && hi.is_finite()).then(|| Aabb::new(Vec3A::from(lo), Vec3A::from(hi)))
 }
 
+/// The shape rows of a primitive: three vertices, or a sphere's centre
+/// and radius (kind in the first row's `w`: 0 triangle, 1 sphere).
+fn shape_rows(p: &Primitive) -> [Vec4; 3] {
+    match *p {
+        Primitive::Triangle([a, b, c]) => [vec4(a, f32::from_bits(0)), vec4(b, 0.0), vec4(c, 0.0)],
+        Primitive::Sphere(centre, r) => [
+            vec4(centre, f32::from_bits(1)),
+            vec4(Vec3::new(r, 0.0, 0.0), 0.0),
+            [0.0; 4],
+        ],
+    }
+}
+
+/// The rows of the 3×4 matrix of `m` (translation in `w`).
+fn affine_rows(m: &Affine3A) -> [Vec4; 3] {
+    let m = glam::Mat4::from(*m).transpose();
+    [
+        m.x_axis.to_array(),
+        m.y_axis.to_array(),
+        m.z_axis.to_array(),
+    ]
+}
+
+/// The rows of the 3×4 matrix of `m` (f64) in f32.
+fn matrix_rows(m: &DMat4) -> [Vec4; 3] {
+    let m = m.transpose().as_mat4();
+    [
+        m.x_axis.to_array(),
+        m.y_axis.to_array(),
+        m.z_axis.to_array(),
+    ]
+}
+
+/// A motion record (12 `vec4f`): the rows of `outer` and of `inner`, then
+/// the translation, rotation (quaternion) and scale at shutter open and
+/// at shutter close (`motion_affine` in `geometry.wgsl`).
+fn motion_record(m: &Motion) -> [Vec4; 12] {
+    let [o0, o1, o2] = matrix_rows(&m.outer);
+    let [i0, i1, i2] = matrix_rows(&m.inner);
+    let pose = |t: &crate::world::Trs| {
+        [
+            vec4(t.translate.as_vec3(), 0.0),
+            t.rotate.as_quat().to_array(),
+            vec4(t.scale.as_vec3(), 0.0),
+        ]
+    };
+    let [a0, a1, a2] = pose(&m.open);
+    let [b0, b1, b2] = pose(&m.close);
+    [o0, o1, o2, i0, i1, i2, a0, a1, a2, b0, b1, b2]
+}
+
 impl Geometry {
+    /// `vec4f` rows per primitive (`PRIM_ROWS` in `geometry.wgsl`).
+    pub fn prim_rows(&self) -> usize {
+        if self.motion { 7 } else { 4 }
+    }
+
     /// `vec4f` rows of shading data per primitive (`SHADING_ROWS` in
     /// `geometry.wgsl`).
     pub fn shading_rows(&self) -> usize {
         if self.tangent_frames { 7 } else { 4 }
     }
 
-    /// Lays out the geometry of `scene`. Motion while the shutter is open
-    /// has no GPU code yet: such scenes are refused.
+    /// Lays out the geometry of `scene`.
     pub fn new(scene: &RenderScene) -> Result<Self, GpuError> {
         let accel = &scene.accel;
-        let surfaces = &scene.surfaces;
         let mut g = Geometry {
             tangent_frames: scene.effects.contains(Effects::TANGENT_FRAMES),
+            motion: scene.motion_blur(),
+            camera_motion: NONE,
             ..Geometry::default()
         };
-        let rows = g.shading_rows();
         let total: usize = accel.blases().iter().map(|b| b.len()).sum();
-        g.shading = vec![[0.0; 4]; rows * total];
-        let mut roots = Vec::with_capacity(accel.blases().len());
-        for (b, blas) in accel.blases().iter().enumerate() {
-            if blas.deforms() {
-                return Err(GpuError::Unsupported(
-                    "meshes that deform while the shutter is open (motion blur)".into(),
-                ));
-            }
-            let base = accel.base(b);
-            let prims = blas.primitives();
-            let boxes: Vec<Option<Aabb>> = prims.iter().map(box_of).collect();
-            let first_slot = (g.prims.len() / 4) as u32;
-            let level = build_level(&boxes, first_slot, &mut g.nodes);
-            roots.push(level.root);
-            for &i in &level.order {
-                let id = base + i;
-                let k = id as usize;
-                let (a, b, c, kind) = match prims[i as usize] {
-                    Primitive::Triangle([a, b, c]) => (a, b, c, 0),
-                    Primitive::Sphere(centre, r) => {
-                        g.spheres = true;
-                        (centre, glam::Vec3::new(r, 0.0, 0.0), glam::Vec3::ZERO, 1)
-                    }
-                };
-                let emitter = surfaces.emitter.get(k).copied().unwrap_or(NO_EMITTER);
-                let info = [
-                    surfaces.material[k],
-                    emitter,
-                    surfaces.emitter_prim.get(k).copied().unwrap_or(0),
-                    id,
-                ];
-                g.prims.extend([
-                    vec4(a, f32::from_bits(kind)),
-                    vec4(b, 0.0),
-                    vec4(c, 0.0),
-                    info.map(f32::from_bits),
-                ]);
-                let n = surfaces.normals[k];
-                let uv = surfaces.uvs.get(k).copied().unwrap_or_default();
-                let row = &mut g.shading[rows * k..rows * (k + 1)];
-                row[..4].copy_from_slice(&[
-                    vec4(n[0], uv[0].x),
-                    vec4(n[1], uv[0].y),
-                    vec4(n[2], uv[1].x),
-                    [uv[1].y, uv[2].x, uv[2].y, 0.0],
-                ]);
-                if let Some(t) = surfaces.tangents.get(k).filter(|_| rows > 4) {
-                    row[4..].copy_from_slice(&t.map(|t| vec4(t, 0.0)));
-                }
-            }
-        }
+        g.shading = vec![[0.0; 4]; g.shading_rows() * total];
+        let roots: Vec<u32> = (0..accel.blases().len())
+            .map(|b| g.bottom_level(scene, b))
+            .collect();
         let instances = accel.instances();
         let direct = instances.len() == 1 && instances[0].place == Place::Identity;
         if direct {
             g.root = roots[instances[0].blas as usize];
-            return Ok(g);
+        } else {
+            g.top_level(scene, &roots);
         }
-        g.instanced = true;
+        if let Some(m) = &scene.camera_motion {
+            g.camera_motion = g.instances.len() as u32;
+            g.instances.extend(motion_record(m));
+        }
+        Ok(g)
+    }
+
+    /// Lays out bottom level `b` of the scene's accelerator: its nodes,
+    /// its primitives in leaf order and their shading data. Returns its
+    /// root.
+    fn bottom_level(&mut self, scene: &RenderScene, b: usize) -> u32 {
+        let surfaces = &scene.surfaces;
+        let blas = &scene.accel.blases()[b];
+        let base = scene.accel.base(b);
+        let prims = blas.primitives();
+        let closing = blas.closing_primitives();
+        // A deforming primitive's box contains it at both ends of the
+        // shutter, so it contains every vertex interpolated between them.
+        let boxes: Vec<Option<Aabb>> = match closing {
+            None => prims.iter().map(box_of).collect(),
+            Some(close) => prims
+                .iter()
+                .zip(close)
+                .map(|(a, b)| Some(box_of(a)?.union(&box_of(b)?)))
+                .collect(),
+        };
+        let first_slot = (self.prims.len() / self.prim_rows()) as u32;
+        let level = build_level(&boxes, first_slot, &mut self.nodes);
+        let rows = self.shading_rows();
+        for &i in &level.order {
+            let id = base + i;
+            let k = id as usize;
+            let p = &prims[i as usize];
+            self.spheres |= matches!(p, Primitive::Sphere(..));
+            let emitter = surfaces.emitter.get(k).copied().unwrap_or(NO_EMITTER);
+            let info = [
+                surfaces.material[k],
+                emitter,
+                surfaces.emitter_prim.get(k).copied().unwrap_or(0),
+                id,
+            ];
+            self.prims.extend(shape_rows(p));
+            self.prims.push(info.map(f32::from_bits));
+            if self.motion {
+                let close = closing.map_or(p, |c| &c[i as usize]);
+                self.prims.extend(shape_rows(close));
+            }
+            let n = surfaces.normals[k];
+            let uv = surfaces.uvs.get(k).copied().unwrap_or_default();
+            let row = &mut self.shading[rows * k..rows * (k + 1)];
+            row[..4].copy_from_slice(&[
+                vec4(n[0], uv[0].x),
+                vec4(n[1], uv[0].y),
+                vec4(n[2], uv[1].x),
+                [uv[1].y, uv[2].x, uv[2].y, 0.0],
+            ]);
+            if let Some(t) = surfaces.tangents.get(k).filter(|_| rows > 4) {
+                row[4..].copy_from_slice(&t.map(|t| vec4(t, 0.0)));
+            }
+        }
+        level.root
+    }
+
+    /// Lays out the instances and the top level over them, and the motion
+    /// records of moving instances after the instances.
+    fn top_level(&mut self, scene: &RenderScene, roots: &[u32]) {
+        let accel = &scene.accel;
+        let instances = accel.instances();
+        self.instanced = true;
         let mut boxes = Vec::with_capacity(instances.len());
+        let mut records = Vec::with_capacity(instances.len() * INSTANCE_ROWS);
+        let mut motions = Vec::new();
         for (i, inst) in instances.iter().enumerate() {
             let (to_object, normals, to_render) = match &inst.place {
-                Place::Identity => (
-                    glam::Affine3A::IDENTITY,
-                    glam::Mat3A::IDENTITY,
-                    glam::Affine3A::IDENTITY,
-                ),
-                Place::Fixed(p) => (p.to_object, p.normals, p.to_render),
-                Place::Moving(_) => {
-                    return Err(GpuError::Unsupported(
-                        "shapes that move while the shutter is open (motion blur)".into(),
-                    ));
+                Place::Identity | Place::Moving(_) => {
+                    (Affine3A::IDENTITY, Mat3A::IDENTITY, Affine3A::IDENTITY)
                 }
+                Place::Fixed(p) => (p.to_object, p.normals, p.to_render),
+            };
+            let motion = match &inst.place {
+                Place::Moving(m) => {
+                    motions.push(motion_record(m));
+                    // Rows from the end of the instance records.
+                    (instances.len() * INSTANCE_ROWS + (motions.len() - 1) * 12) as u32
+                }
+                _ => NONE,
             };
             boxes.push(accel.instance_bounds(i));
-            let rows = |a: &glam::Affine3A| {
-                let m = glam::Mat4::from(*a).transpose();
-                [
-                    m.x_axis.to_array(),
-                    m.y_axis.to_array(),
-                    m.z_axis.to_array(),
-                ]
-            };
             let n = glam::Mat3::from(normals).transpose();
-            let meta = [
-                roots[inst.blas as usize],
-                match scene.instance_material[i] {
-                    NO_MATERIAL => u32::MAX,
-                    m => m,
-                },
-                0,
-                0,
-            ];
-            g.instances.extend(rows(&to_object));
-            g.instances.extend([
+            let material = match scene.instance_material[i] {
+                NO_MATERIAL => NONE,
+                m => m,
+            };
+            let meta = [roots[inst.blas as usize], material, motion, 0];
+            records.extend(affine_rows(&to_object));
+            records.extend([
                 vec4(n.x_axis, 0.0),
                 vec4(n.y_axis, 0.0),
                 vec4(n.z_axis, 0.0),
             ]);
-            g.instances.extend(rows(&to_render));
-            g.instances.push(meta.map(f32::from_bits));
+            records.extend(affine_rows(&to_render));
+            records.push(meta.map(f32::from_bits));
         }
         // The top level's leaves reference instance indices directly: its
         // order permutes the instances.
-        let level = build_level(&boxes, 0, &mut g.nodes);
-        let mut ordered = Vec::with_capacity(g.instances.len());
+        let level = build_level(&boxes, 0, &mut self.nodes);
         for &i in &level.order {
-            ordered.extend_from_slice(&g.instances[i as usize * 10..i as usize * 10 + 10]);
+            let at = i as usize * INSTANCE_ROWS;
+            self.instances
+                .extend_from_slice(&records[at..at + INSTANCE_ROWS]);
         }
-        g.instances = ordered;
-        g.root = level.root;
-        Ok(g)
+        self.instances.extend(motions.iter().flatten());
+        self.root = level.root;
     }
 }

@@ -5,10 +5,11 @@
 // Nodes are 4 vec4f: both children's boxes, each with a reference (a node
 // index, or the first primitive slot of a leaf) and a primitive count
 // (0: inner). An inner reference of NO_HIT is an empty child: it becomes
-// `next` and is dropped like a missed box. Primitives are 4 vec4f: v0 (kind in w: 0 triangle, 1
-// sphere), v1, v2 (sphere: centre in v0, radius in v1.x), then
-// (material, emitter, emitter primitive, primitive number) as bits; the
-// primitive number (the CPU's) indexes the shading data.
+// `next` and is dropped like a missed box. Primitives are PRIM_ROWS vec4f:
+// v0 (kind in w: 0 triangle, 1 sphere), v1, v2 (sphere: centre in v0,
+// radius in v1.x), then (material, emitter, emitter primitive, primitive
+// number) as bits, the primitive number (the CPU's) indexing the shading
+// data; under MOTION then v0, v1, v2 at shutter close (upload.rs).
 
 const STACK_SIZE: u32 = 48u;
 const NO_HIT: u32 = 0xffffffffu;
@@ -23,6 +24,15 @@ var<private> stat_nodes: u32 = 0u;
 var<private> stat_prims: u32 = 0u;
 //#endif
 
+//#if MOTION
+const PRIM_ROWS: u32 = 7u;
+// The time of the ray being traced in the shutter, τ in [0, 1) (one per
+// path: the integrator sets it when the path starts).
+var<private> ray_time: f32 = 0.0;
+//#else
+const PRIM_ROWS: u32 = 4u;
+//#endif
+
 struct Hit {
     t: f32,
     slot: u32,
@@ -32,18 +42,30 @@ struct Hit {
 }
 
 fn prim_kind(slot: u32) -> u32 {
-    return bitcast<u32>(prims[4u * slot].w);
+    return bitcast<u32>(prims[PRIM_ROWS * slot].w);
 }
 
 fn prim_info(slot: u32) -> vec4u {
-    return bitcast<vec4u>(prims[4u * slot + 3u]);
+    return bitcast<vec4u>(prims[PRIM_ROWS * slot + 3u]);
+}
+
+// Vertex k of a triangle at the ray's time (blas.rs `primitive`: the
+// shutter-open vertex moved linearly towards the shutter-close one).
+fn prim_vertex(slot: u32, k: u32) -> vec3f {
+    let open = prims[PRIM_ROWS * slot + k].xyz;
+//#if MOTION
+    let close = prims[PRIM_ROWS * slot + 4u + k].xyz;
+    return open + (close - open) * ray_time;
+//#else
+    return open;
+//#endif
 }
 
 // Möller–Trumbore; updates `best` where the triangle is closer.
 fn hit_triangle(slot: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>) -> bool {
-    let v0 = prims[4u * slot].xyz;
-    let e1 = prims[4u * slot + 1u].xyz - v0;
-    let e2 = prims[4u * slot + 2u].xyz - v0;
+    let v0 = prim_vertex(slot, 0u);
+    let e1 = prim_vertex(slot, 1u) - v0;
+    let e2 = prim_vertex(slot, 2u) - v0;
     let pv = cross(d, e2);
     let det = dot(e1, pv);
     if det == 0.0 {
@@ -74,8 +96,8 @@ fn hit_triangle(slot: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>) -> bool
 //#if SPHERES
 // Haines et al.'s precise ray–sphere test (accel/sphere.rs).
 fn hit_sphere(slot: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>) -> bool {
-    let c = prims[4u * slot].xyz;
-    let r = prims[4u * slot + 1u].x;
+    let c = prims[PRIM_ROWS * slot].xyz;
+    let r = prims[PRIM_ROWS * slot + 1u].x;
     let f = o - c;
     let a = dot(d, d);
     let b = -dot(f, d);
@@ -217,7 +239,9 @@ fn trace_blas(root: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>, any: bool
 //#if INSTANCES
 // Instances are 10 vec4f: the rows of render → object, of the normal
 // matrix and of object → render, then (bottom-level root, material or
-// NO_MATERIAL, 0, 0) as bits.
+// NO_HIT, motion record or NO_HIT, 0) as bits. A moving instance's rows
+// are unused: its placement is made from its motion record at the ray's
+// time.
 fn instance_row(inst: u32, row: u32) -> vec4f {
     return instances[10u * inst + row];
 }
@@ -225,20 +249,126 @@ fn instance_row(inst: u32, row: u32) -> vec4f {
 fn instance_meta(inst: u32) -> vec4u {
     return bitcast<vec4u>(instances[10u * inst + 9u]);
 }
+//#endif
 
-fn affine_point(inst: u32, first: u32, p: vec3f) -> vec3f {
-    let p4 = vec4f(p, 1.0);
-    return vec3f(dot(instance_row(inst, first), p4), dot(instance_row(inst, first + 1u), p4), dot(instance_row(inst, first + 2u), p4));
+// An affine transform: x ↦ l·x + t.
+struct Affine {
+    l: mat3x3f,
+    t: vec3f,
 }
 
-fn affine_vector(inst: u32, first: u32, v: vec3f) -> vec3f {
-    let v4 = vec4f(v, 0.0);
-    return vec3f(dot(instance_row(inst, first), v4), dot(instance_row(inst, first + 1u), v4), dot(instance_row(inst, first + 2u), v4));
+fn affine_point(a: Affine, p: vec3f) -> vec3f {
+    return a.l * p + a.t;
 }
 
-fn affine_abs_vector(inst: u32, first: u32, v: vec3f) -> vec3f {
-    let v4 = vec4f(v, 0.0);
-    return vec3f(dot(abs(instance_row(inst, first)), v4), dot(abs(instance_row(inst, first + 1u)), v4), dot(abs(instance_row(inst, first + 2u)), v4));
+// The transform whose 3×4 matrix has rows r0, r1, r2 (translation in w).
+fn affine_from_rows(r0: vec4f, r1: vec4f, r2: vec4f) -> Affine {
+    return Affine(transpose(mat3x3f(r0.xyz, r1.xyz, r2.xyz)), vec3f(r0.w, r1.w, r2.w));
+}
+
+// a after b.
+fn affine_compose(a: Affine, b: Affine) -> Affine {
+    return Affine(a.l * b.l, a.l * b.t + a.t);
+}
+
+//#if MOTION
+// The inverse of an invertible affine transform.
+fn affine_inverse(a: Affine) -> Affine {
+    let c0 = a.l[0];
+    let c1 = a.l[1];
+    let c2 = a.l[2];
+    let r0 = cross(c1, c2);
+    let r1 = cross(c2, c0);
+    let r2 = cross(c0, c1);
+    let inv_det = 1.0 / dot(c0, r0);
+    let l = transpose(mat3x3f(r0, r1, r2)) * inv_det;
+    return Affine(l, -(l * a.t));
+}
+
+// The rotation matrix of the unit quaternion q (x, y, z, w).
+fn quat_matrix(q: vec4f) -> mat3x3f {
+    let x2 = q.x + q.x;
+    let y2 = q.y + q.y;
+    let z2 = q.z + q.z;
+    let xx = q.x * x2;
+    let xy = q.x * y2;
+    let xz = q.x * z2;
+    let yy = q.y * y2;
+    let yz = q.y * z2;
+    let zz = q.z * z2;
+    let wx = q.w * x2;
+    let wy = q.w * y2;
+    let wz = q.w * z2;
+    return mat3x3f(
+        vec3f(1.0 - (yy + zz), xy + wz, xz - wy),
+        vec3f(xy - wz, 1.0 - (xx + zz), yz + wx),
+        vec3f(xz + wy, yz - wx, 1.0 - (xx + yy)),
+    );
+}
+
+// Shortest-path slerp (world/animation.rs `slerp`).
+fn quat_slerp(a: vec4f, b0: vec4f, s: f32) -> vec4f {
+    var b = b0;
+    var c = dot(a, b);
+    if c < 0.0 {
+        c = -c;
+        b = -b;
+    }
+    if c > 1.0 - 1e-6 {
+        return normalize(a + (b - a) * s);
+    }
+    let angle = acos(clamp(c, -1.0, 1.0));
+    let sin_angle = sin(angle);
+    return normalize(a * (sin((1.0 - s) * angle) / sin_angle) + b * (sin(s * angle) / sin_angle));
+}
+
+// The object → render transform of the motion record at row `at` of
+// `instances` at shutter time tau (instance.rs `Motion::matrix`): outer ·
+// T·R·S(τ) · inner, translation and scale linear in τ, rotation by slerp.
+fn motion_affine(at: u32, tau: f32) -> Affine {
+    let outer = affine_from_rows(instances[at], instances[at + 1u], instances[at + 2u]);
+    let inner = affine_from_rows(instances[at + 3u], instances[at + 4u], instances[at + 5u]);
+    let t = mix(instances[at + 6u].xyz, instances[at + 9u].xyz, tau);
+    let q = quat_slerp(instances[at + 7u], instances[at + 10u], tau);
+    let sc = mix(instances[at + 8u].xyz, instances[at + 11u].xyz, tau);
+    let r = quat_matrix(q);
+    let pose = Affine(mat3x3f(r[0] * sc.x, r[1] * sc.y, r[2] * sc.z), t);
+    return affine_compose(outer, affine_compose(pose, inner));
+}
+//#endif
+
+//#if INSTANCES
+// Render → object space of instance `inst` at the ray's time.
+fn instance_to_object(inst: u32) -> Affine {
+//#if MOTION
+    let motion = instance_meta(inst).z;
+    if motion != NO_HIT {
+        return affine_inverse(motion_affine(motion, ray_time));
+    }
+//#endif
+    return affine_from_rows(instance_row(inst, 0u), instance_row(inst, 1u), instance_row(inst, 2u));
+}
+
+// An instance's placement at the ray's time (instance.rs `Placement`).
+struct Placement {
+    to_object: Affine,
+    normals: mat3x3f,
+    to_render: Affine,
+}
+
+fn instance_placement(inst: u32) -> Placement {
+//#if MOTION
+    let motion = instance_meta(inst).z;
+    if motion != NO_HIT {
+        let to_render = motion_affine(motion, ray_time);
+        let to_object = affine_inverse(to_render);
+        return Placement(to_object, transpose(to_object.l), to_render);
+    }
+//#endif
+    let to_object = affine_from_rows(instance_row(inst, 0u), instance_row(inst, 1u), instance_row(inst, 2u));
+    let normals = transpose(mat3x3f(instance_row(inst, 3u).xyz, instance_row(inst, 4u).xyz, instance_row(inst, 5u).xyz));
+    let to_render = affine_from_rows(instance_row(inst, 6u), instance_row(inst, 7u), instance_row(inst, 8u));
+    return Placement(to_object, normals, to_render);
 }
 
 fn trace_scene(o: vec3f, d: vec3f, best: ptr<function, Hit>, any: bool) -> bool {
@@ -272,8 +402,9 @@ fn trace_scene(o: vec3f, d: vec3f, best: ptr<function, Hit>, any: bool) -> bool 
                 for (var i = 0u; i < count; i++) {
                     let inst = first + i;
                     // The ray in the instance's space (same t).
-                    let oo = affine_point(inst, 0u, o);
-                    let od = affine_vector(inst, 0u, d);
+                    let to_object = instance_to_object(inst);
+                    let oo = affine_point(to_object, o);
+                    let od = to_object.l * d;
                     if trace_blas(instance_meta(inst).x, oo, od, best, any) {
                         (*best).inst = inst;
                         found = true;
@@ -463,8 +594,8 @@ fn local_interaction(hit: Hit, o: vec3f, d: vec3f) -> Interaction {
     let sh = info.w;
 //#if SPHERES
     if prim_kind(slot) == 1u {
-        let c = prims[4u * slot].xyz;
-        let r = prims[4u * slot + 1u].x;
+        let c = prims[PRIM_ROWS * slot].xyz;
+        let r = prims[PRIM_ROWS * slot + 1u].x;
         let n = normalize(o + d * hit.t - c);
         it.p = c + n * r;
         it.err = (abs(it.p) + abs(c)) * GAMMA5;
@@ -486,9 +617,9 @@ fn local_interaction(hit: Hit, o: vec3f, d: vec3f) -> Interaction {
         return it;
     }
 //#endif
-    let v0 = prims[4u * slot].xyz;
-    let v1 = prims[4u * slot + 1u].xyz;
-    let v2 = prims[4u * slot + 2u].xyz;
+    let v0 = prim_vertex(slot, 0u);
+    let v1 = prim_vertex(slot, 1u);
+    let v2 = prim_vertex(slot, 2u);
     let b = vec3f(1.0 - hit.b1 - hit.b2, hit.b1, hit.b2);
     let w0 = v0 * b.x;
     let w1 = v1 * b.y;
@@ -531,24 +662,23 @@ fn interaction(hit: Hit, o: vec3f, d: vec3f) -> Interaction {
 //#if INSTANCES
     let inst = hit.inst;
     let m = instance_meta(inst);
-    let oo = affine_point(inst, 0u, o);
-    let od = affine_vector(inst, 0u, d);
-    var it = local_interaction(hit, oo, od);
+    let place = instance_placement(inst);
+    var it = local_interaction(hit, affine_point(place.to_object, o), place.to_object.l * d);
     if m.y != NO_HIT {
         it.material = m.y;
     }
     // Out to render space with the transform's rounding error (instance.rs).
+    let to_render = place.to_render;
+    let abs_l = mat3x3f(abs(to_render.l[0]), abs(to_render.l[1]), abs(to_render.l[2]));
     let p = it.p;
-    it.p = affine_point(inst, 6u, p);
-    let translation = abs(vec3f(instance_row(inst, 6u).w, instance_row(inst, 7u).w, instance_row(inst, 8u).w));
-    it.err = affine_abs_vector(inst, 6u, it.err) * (GAMMA3 + 1.0)
-        + (affine_abs_vector(inst, 6u, abs(p)) + translation) * GAMMA3;
-    it.ng = normalize(affine_vector(inst, 3u, it.ng));
-    let ns = above_tangent_plane(normalize(affine_vector(inst, 3u, it.frame[2])), it.ng);
+    it.p = affine_point(to_render, p);
+    it.err = (abs_l * it.err) * (GAMMA3 + 1.0) + (abs_l * abs(p) + abs(to_render.t)) * GAMMA3;
+    it.ng = normalize(place.normals * it.ng);
+    let ns = above_tangent_plane(normalize(place.normals * it.frame[2]), it.ng);
 //#if TANGENT_FRAMES
-    it.dp_du = affine_vector(inst, 6u, it.dp_du);
-    it.dp_dv = affine_vector(inst, 6u, it.dp_dv);
-    it.frame = frame_with_tangent(ns, affine_vector(inst, 6u, it.frame[0]));
+    it.dp_du = to_render.l * it.dp_du;
+    it.dp_dv = to_render.l * it.dp_dv;
+    it.frame = frame_with_tangent(ns, to_render.l * it.frame[0]);
     if !frame_usable(it.frame) {
         it.frame = frame_around_z(ns);
     }

@@ -17,3 +17,4 @@ const H_ENVIRONMENT_COUNT: u32 = 13u;
 const H_SPLAT: u32 = 14u;
 const H_SPLAT_SCALE: u32 = 15u;
 const H_SPLAT_REACH: u32 = 16u;
+const H_CAMERA_MOTION: u32 = 17u;

@@ -39,7 +39,13 @@ struct FrameUniform {
 override MAX_DEPTH: u32 = 8u;
 override RR_DEPTH: u32 = 5u;
 
+// Sampler dimensions of the camera (film position, lens; under MOTION one
+// more, the path's time in the shutter) and of each bounce.
+//#if MOTION
+const CAMERA_DIMS: u32 = 5u;
+//#else
 const CAMERA_DIMS: u32 = 4u;
+//#endif
 const BOUNCE_DIMS: u32 = 8u;
 const SHADOW_EPSILON: f32 = 1e-4;
 const NO_EMITTER: u32 = 0xffffffffu;
@@ -157,6 +163,17 @@ fn trace_path(px: u32, py: u32, index: u32, rays: ptr<function, u32>, shadow_ray
     let ray = camera_ray(film_pos, sample_2d(pixel, index, 2u));
     var o = ray.origin;
     var d = ray.dir;
+//#if MOTION
+    // Each path lives at one time of the shutter (a box shutter); the
+    // camera ray moves to where the camera is then (path.rs).
+    ray_time = sample_1d(pixel, index, 4u);
+    let camera_motion = param_u32(H_CAMERA_MOTION);
+    if camera_motion != NO_HIT {
+        let m = motion_affine(camera_motion, ray_time);
+        o = affine_point(m, o);
+        d = normalize(m.l * d);
+    }
+//#endif
     var beta = vec3f(ray.weight);
     var eta_scale = 1.0;
     var radiance = vec3f(0.0);
