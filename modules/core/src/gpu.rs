@@ -21,12 +21,16 @@
 //!          fn light_escaped_T(p: u32, dir: vec3f) -> EmitterEval     (environment lights)
 //! camera:  fn camera_ray_T(p: u32, film: vec2f, lens: vec2f) -> CameraRay
 //! sampler: fn sample_1d_T(p: u32, pixel: u32, index: u32, dim: u32) -> f32
+//!          fn sample_2d_T(p: u32, pixel: u32, index: u32, dim: u32) -> vec2f
+//!                                           (optional: else two 1D values)
 //! texture: fn texture_T(p: u32, uv: vec2f) -> vec3f
 //! ```
 //!
 //! with the structures of the Rust traits (directions in the local shading
 //! frame for shaders, in render space elsewhere); shaders read their
-//! textures with `texture_eval(id, uv)`. Filters need no WGSL: the backend
+//! textures with `texture_eval(id, uv)`. A sampler whose `fill_2d` is not
+//! two `fill_1d` values (a stratified 2D pattern) defines `sample_2d_T` as
+//! well, so that the GPU draws the same pairs. Filters need no WGSL: the backend
 //! samples any filter from its tabulated distribution
 //! ([`FilterSampler`](crate::FilterSampler)).
 

@@ -22,7 +22,9 @@ pub(crate) trait Pointwise {
         Vec2::new(self.value_1d(id, dim), self.value_1d(id, dim + 1))
     }
 
-    /// The sampler's GPU side: `sample_1d_T` computing [`value_1d`](Self::value_1d).
+    /// The sampler's GPU side: `sample_1d_T` computing
+    /// [`value_1d`](Self::value_1d), and `sample_2d_T` computing
+    /// [`value_2d`](Self::value_2d) where that is not the default.
     fn gpu(&self) -> Option<radiant_core::GpuModule> {
         None
     }

@@ -86,7 +86,11 @@ impl Pointwise for Stratified {
             GpuModule::new(
                 "stratified",
                 include_str!("stratified.wgsl"),
-                GpuParams::new().u32(self.seed).u32(self.spp),
+                GpuParams::new()
+                    .u32(self.seed)
+                    .u32(self.spp)
+                    .u32(self.cols)
+                    .u32(self.rows),
             )
             .with_libraries(&[SCRAMBLE_WGSL]),
         )

@@ -351,10 +351,20 @@ fn dispatchers(m: &Modules) -> String {
         );
     }
     if let [smp] = m.sampler.types.as_slice() {
+        let t = &smp.ident;
         let _ = writeln!(
             s,
-            "fn sample_1d(pixel: u32, index: u32, dim: u32) -> f32 {{\n    return sample_1d_{}(param_u32(H_SAMPLER), pixel, index, dim);\n}}\n",
-            smp.ident
+            "fn sample_1d(pixel: u32, index: u32, dim: u32) -> f32 {{\n    return sample_1d_{t}(param_u32(H_SAMPLER), pixel, index, dim);\n}}\n"
+        );
+        // A sampler without 2D code draws its pairs as two 1D values.
+        let pair = if smp.wgsl.contains(&format!("fn sample_2d_{t}(")) {
+            format!("sample_2d_{t}(param_u32(H_SAMPLER), pixel, index, dim)")
+        } else {
+            "vec2f(sample_1d(pixel, index, dim), sample_1d(pixel, index, dim + 1u))".into()
+        };
+        let _ = writeln!(
+            s,
+            "fn sample_2d(pixel: u32, index: u32, dim: u32) -> vec2f {{\n    return {pair};\n}}\n"
         );
     }
     if m.shaders.types.is_empty() {

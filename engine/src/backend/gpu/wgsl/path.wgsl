@@ -50,10 +50,6 @@ const BOUNCE_DIMS: u32 = 8u;
 const SHADOW_EPSILON: f32 = 1e-4;
 const NO_EMITTER: u32 = 0xffffffffu;
 
-fn sample_2d(pixel: u32, index: u32, dim: u32) -> vec2f {
-    return vec2f(sample_1d(pixel, index, dim), sample_1d(pixel, index, dim + 1u));
-}
-
 // An offset from the pixel centre drawn from the tabulated filter
 // (rows: marginal CDF; then per row its CDF; then the signs), and its
 // weight f/pdf.
