@@ -161,3 +161,40 @@ fn motion_blurred_frame_matches_the_cpu() {
         assert!(!tolerances.passes(&check_against(&scaled, &cpu, 8)));
     }
 }
+
+/// Frames reuse what did not change on the device: a camera move keeps the
+/// geometry's buffers (one upload for two frames), a moving shape uploads
+/// its frame's geometry.
+#[test]
+fn frames_upload_only_changed_geometry() {
+    use radiant::backend::cpu::Progress;
+    use radiant::extract::{Sequence, SequenceOptions};
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let moving = std::fs::read_to_string(scene(dir.path())).expect("the scene reads");
+    // The same scene with only the camera moving, and no shutter.
+    let still = moving
+        .replace("  shutter: [0, 1]\n", "")
+        .split("  - name: tumbling")
+        .next()
+        .expect("the shapes precede the animated ones")
+        .to_string();
+    let registry = radiant::builtin_registry();
+    let mut gpu = backend();
+    for (text, uploads) in [(still, 1), (moving, 2)] {
+        let mut loaded = radiant::scene::from_str(&text, Path::new("frames.yaml"), dir.path())
+            .expect("the scene parses");
+        let options = SequenceOptions::default();
+        let (mut sequence, _) =
+            Sequence::new(&mut loaded, &registry, &Overrides::default(), &options, 1)
+                .expect("the scene extracts");
+        let before = gpu.geometry_uploads();
+        gpu.render(sequence.scene(), &Progress::none())
+            .expect("frame 1 renders");
+        sequence
+            .go_to(&mut loaded, &registry, 2)
+            .expect("frame 2 extracts");
+        gpu.render(sequence.scene(), &Progress::none())
+            .expect("frame 2 renders");
+        assert_eq!(gpu.geometry_uploads() - before, uploads);
+    }
+}

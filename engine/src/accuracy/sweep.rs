@@ -312,7 +312,7 @@ pub fn measure(
     reference.check_size(render.settings.width, render.settings.height)?;
     let gpu = match setting.change {
         Change::Gpu => {
-            crate::backend::gpu::Plan::new(&render)?;
+            crate::backend::gpu::Plan::check(&render)?;
             Some(super::shared_gpu().map_err(AccuracyError::NoGpu)?)
         }
         _ => None,

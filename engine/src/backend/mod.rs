@@ -193,11 +193,11 @@ pub fn choose(
     match kind {
         BackendKind::Cpu => Ok(Box::new(CpuBackend)),
         BackendKind::Gpu => {
-            gpu::Plan::new(scene)?;
+            gpu::Plan::check(scene)?;
             Ok(Box::new(gpu::GpuBackend::new(options)?))
         }
         BackendKind::Auto => {
-            if let Err(e) = gpu::Plan::new(scene) {
+            if let Err(e) = gpu::Plan::check(scene) {
                 note(format!("backend: cpu ({e})"));
                 return Ok(Box::new(CpuBackend));
             }

@@ -12,6 +12,7 @@
 //! the bottom levels that did not change, is left to do.)
 
 mod bvh;
+mod cwbvh;
 mod device;
 pub mod error;
 pub mod kernel;
@@ -20,6 +21,7 @@ pub mod probe;
 pub mod trace;
 pub mod upload;
 
+pub use bvh::BvhLayout;
 pub use device::GpuOptions;
 pub use error::GpuError;
 
@@ -97,11 +99,23 @@ pub struct Plan {
 }
 
 impl Plan {
+    /// Whether `scene` can render on the GPU, without laying out its
+    /// geometry: fails, naming it, on a module without GPU code (the only
+    /// way planning fails).
+    pub fn check(scene: &RenderScene) -> Result<(), GpuError> {
+        Modules::new(scene).map(drop)
+    }
+
     /// Plans `scene` for the GPU: fails, naming it, on a module without
-    /// GPU code or a feature the backend lacks.
+    /// GPU code.
     pub fn new(scene: &RenderScene) -> Result<Self, GpuError> {
+        Self::with_bvh(scene, BvhLayout::default())
+    }
+
+    /// [`Plan::new`] with hierarchies of `layout`.
+    pub fn with_bvh(scene: &RenderScene, layout: BvhLayout) -> Result<Self, GpuError> {
         let mut modules = Modules::new(scene)?;
-        let geometry = Geometry::new(scene)?;
+        let geometry = Geometry::new(scene, layout)?;
         modules.locate(&geometry);
         let features = Features::of(scene, &geometry, &modules);
         let kernel = Kernel::assemble(&modules, features);
@@ -193,6 +207,16 @@ struct FrameBuffers {
     reach: u32,
 }
 
+/// The geometry buffers on the device, with the bytes they hold (to tell
+/// whether the next frame's geometry is the same).
+struct ResidentGeometry {
+    nodes: wgpu::Buffer,
+    prims: wgpu::Buffer,
+    shading: wgpu::Buffer,
+    instances: wgpu::Buffer,
+    bytes: [Vec<u8>; 4],
+}
+
 /// The GPU backend: a device and what it keeps between frames.
 pub struct GpuBackend {
     device: wgpu::Device,
@@ -200,9 +224,16 @@ pub struct GpuBackend {
     info: wgpu::AdapterInfo,
     limits: wgpu::Limits,
     pipeline: Option<Pipeline>,
+    /// The last frame's geometry buffers.
+    geometry: Option<ResidentGeometry>,
+    /// Geometry uploads so far (a frame whose geometry is the last one's
+    /// uploads none).
+    uploads: u64,
     layout: wgpu::BindGroupLayout,
     errors: device::ErrorSink,
     stats: bool,
+    /// The hierarchy layout of the frames' geometry.
+    bvh: BvhLayout,
     last: GpuStats,
 }
 
@@ -226,6 +257,39 @@ fn storage(device: &wgpu::Device, label: &str, data: &[u8], writable: bool) -> w
     })
 }
 
+/// The buffers of `g` on `device`: the last frame's (`kept`) where its
+/// geometry is the same (a still scene's frames, a camera move,
+/// progressive passes), else uploaded anew (counted in `uploads`) and kept
+/// for the next.
+fn resident<'a>(
+    device: &wgpu::Device,
+    kept: &'a mut Option<ResidentGeometry>,
+    uploads: &mut u64,
+    g: &Geometry,
+) -> &'a ResidentGeometry {
+    let arrays: [&[u8]; 4] = [
+        bytemuck::cast_slice(&g.nodes),
+        bytemuck::cast_slice(&g.prims),
+        bytemuck::cast_slice(&g.shading),
+        bytemuck::cast_slice(&g.instances),
+    ];
+    let same = kept
+        .as_ref()
+        .is_some_and(|r| r.bytes.iter().zip(&arrays).all(|(a, b)| a == b));
+    if !same {
+        let d = device;
+        *kept = Some(ResidentGeometry {
+            nodes: storage(d, "nodes", arrays[0], false),
+            prims: storage(d, "prims", arrays[1], false),
+            shading: storage(d, "shading", arrays[2], false),
+            instances: storage(d, "instances", arrays[3], false),
+            bytes: arrays.map(<[u8]>::to_vec),
+        });
+        *uploads += 1;
+    }
+    kept.as_ref().expect("made above")
+}
+
 impl GpuBackend {
     /// Opens an adapter as `options` say.
     pub fn new(options: &GpuOptions) -> Result<Self, GpuError> {
@@ -233,6 +297,7 @@ impl GpuBackend {
         let layout = bind_group_layout(&device);
         Ok(Self {
             stats: options.stats,
+            bvh: options.bvh,
             last: GpuStats::default(),
             layout,
             device,
@@ -240,6 +305,8 @@ impl GpuBackend {
             info,
             limits,
             pipeline: None,
+            geometry: None,
+            uploads: 0,
             errors,
         })
     }
@@ -250,6 +317,12 @@ impl GpuBackend {
             "{} ({:?}, {:?})",
             self.info.name, self.info.backend, self.info.device_type
         )
+    }
+
+    /// How many times a frame's geometry was uploaded: frames whose
+    /// geometry is the same as the last one's reuse its buffers.
+    pub fn geometry_uploads(&self) -> u64 {
+        self.uploads
     }
 
     /// What the last render counted.
@@ -408,7 +481,7 @@ impl GpuBackend {
     /// Plans `scene` (with the traversal counters where asked) and makes
     /// sure its pipeline is compiled.
     fn compile(&mut self, scene: &RenderScene) -> Result<Plan, GpuError> {
-        let mut plan = Plan::new(scene)?;
+        let mut plan = Plan::with_bvh(scene, self.bvh)?;
         if self.stats {
             let features = kernel::Features {
                 stats: true,
@@ -431,7 +504,7 @@ impl GpuBackend {
     /// (`layers` layers), the counters, and one uniform slot per dispatch
     /// of `work` (sample indices from `first_sample` on).
     fn upload(
-        &self,
+        &mut self,
         plan: &Plan,
         (w, h): (u32, u32),
         layers: u32,
@@ -449,7 +522,7 @@ impl GpuBackend {
         let g = &plan.geometry;
         self.fits("the splatted samples", splat_bytes)?;
         self.fits("the film", pixels * film_layers * 16)?;
-        self.fits("the BVH nodes", g.nodes.len() * 64)?;
+        self.fits("the BVH nodes", g.nodes.len() * 16)?;
         self.fits("the primitives", g.prims.len() * 16)?;
         self.fits("the shading data", g.shading.len() * 16)?;
         self.fits("the module parameters", plan.modules.params.len() * 4)?;
@@ -481,17 +554,19 @@ impl GpuBackend {
                 mapped_at_creation: false,
             })
         };
+        let params = storage(
+            d,
+            "params",
+            bytemuck::cast_slice(&plan.modules.params),
+            false,
+        );
+        let resident = resident(&self.device, &mut self.geometry, &mut self.uploads, g);
         let read_only = [
-            storage(
-                d,
-                "params",
-                bytemuck::cast_slice(&plan.modules.params),
-                false,
-            ),
-            storage(d, "nodes", bytemuck::cast_slice(&g.nodes), false),
-            storage(d, "prims", bytemuck::cast_slice(&g.prims), false),
-            storage(d, "shading", bytemuck::cast_slice(&g.shading), false),
-            storage(d, "instances", bytemuck::cast_slice(&g.instances), false),
+            &params,
+            &resident.nodes,
+            &resident.prims,
+            &resident.shading,
+            &resident.instances,
         ];
         let film = empty(
             "film",
@@ -508,7 +583,8 @@ impl GpuBackend {
                 size: wgpu::BufferSize::new(32),
             }),
         }];
-        for (binding, buffer) in (1..).zip(read_only.iter().chain([&film, &counters, &splats])) {
+        for (binding, buffer) in (1..).zip(read_only.into_iter().chain([&film, &counters, &splats]))
+        {
             entries.push(wgpu::BindGroupEntry {
                 binding,
                 resource: buffer.as_entire_binding(),
