@@ -256,68 +256,74 @@ pub fn read(path: &Path) -> Result<Partial, PartialError> {
     Ok(Partial { header, sums })
 }
 
-/// The [`Header`] stored in `attributes` of a `size` layer.
+/// The `radiant.*` attributes of a partial file's layer.
+struct Attributes<'a> {
+    path: &'a Path,
+    map: &'a HashMap<Text, AttributeValue>,
+}
+
+impl Attributes<'_> {
+    /// The text of `radiant.{key}`.
+    fn text(&self, key: &str) -> Result<String, PartialError> {
+        let name = format!("radiant.{key}");
+        match self.map.get(&Text::from(name.as_str())) {
+            Some(AttributeValue::Text(t)) => Ok(t.to_string()),
+            _ => Err(PartialError::NotPartial {
+                path: self.path.to_path_buf(),
+                missing: format!("it has no `{name}` attribute"),
+            }),
+        }
+    }
+
+    /// `radiant.{key}` as `read` reads it (`None`: not valid).
+    fn read<T>(&self, key: &str, read: impl FnOnce(&str) -> Option<T>) -> Result<T, PartialError> {
+        let value = self.text(key)?;
+        read(&value).ok_or_else(|| PartialError::BadAttribute {
+            path: self.path.to_path_buf(),
+            name: format!("radiant.{key}"),
+            value,
+        })
+    }
+
+    /// `radiant.{key}` parsed.
+    fn parse<T: std::str::FromStr>(&self, key: &str) -> Result<T, PartialError> {
+        self.read(key, |v| v.parse().ok())
+    }
+}
+
+/// The [`Header`] stored in `attributes` of a `size` layer of the file at
+/// `path`.
 fn parse_header(
     path: &Path,
     attributes: &HashMap<Text, AttributeValue>,
     size: exr::prelude::Vec2<usize>,
 ) -> Result<Header, PartialError> {
-    let text = |key: &str| -> Result<String, PartialError> {
-        let name = format!("radiant.{key}");
-        match attributes.get(&Text::from(name.as_str())) {
-            Some(AttributeValue::Text(t)) => Ok(t.to_string()),
-            _ => Err(PartialError::NotPartial {
-                path: path.to_path_buf(),
-                missing: format!("it has no `{name}` attribute"),
-            }),
-        }
+    let a = Attributes {
+        path,
+        map: attributes,
     };
-    fn parsed<T: std::str::FromStr>(
-        path: &Path,
-        key: &str,
-        value: String,
-    ) -> Result<T, PartialError> {
-        value.parse().map_err(|_| PartialError::BadAttribute {
-            path: path.to_path_buf(),
-            name: format!("radiant.{key}"),
-            value,
-        })
-    }
-    let field = |key: &str| text(key).map(|v| (key.to_string(), v));
-    let number = |key: &str| field(key).and_then(|(k, v)| parsed::<u64>(path, &k, v));
-    let partition: Partition = field("partition").and_then(|(k, v)| parsed(path, &k, v))?;
-    let (samples_key, samples_text) = field("samples")?;
-    let samples = samples_text
-        .split_once("..")
-        .and_then(|(a, b)| Some(a.parse::<u32>().ok()?..b.parse::<u32>().ok()?))
-        .filter(|r| !r.is_empty())
-        .ok_or_else(|| PartialError::BadAttribute {
-            path: path.to_path_buf(),
-            name: format!("radiant.{samples_key}"),
-            value: samples_text.clone(),
-        })?;
-    let (digest_key, digest_text) = field("scene_crc32")?;
-    let scene_digest =
-        u32::from_str_radix(&digest_text, 16).map_err(|_| PartialError::BadAttribute {
-            path: path.to_path_buf(),
-            name: format!("radiant.{digest_key}"),
-            value: digest_text.clone(),
-        })?;
-    let spp = field("spp").and_then(|(k, v)| parsed(path, &k, v))?;
+    let spp = a.parse("spp")?;
+    let partition: Partition = a.parse("partition")?;
+    // The range must be the partition's: merges rely on it.
+    let samples = a.read("samples", |v| {
+        let (start, end) = v.split_once("..")?;
+        let samples = start.parse().ok()?..end.parse().ok()?;
+        (partition.samples(spp).ok()? == samples).then_some(samples)
+    })?;
     Ok(Header {
-        scene: text("scene")?,
-        scene_digest,
-        frame: field("frame").and_then(|(k, v)| parsed(path, &k, v))?,
+        scene: a.text("scene")?,
+        scene_digest: a.read("scene_crc32", |v| u32::from_str_radix(v, 16).ok())?,
+        frame: a.parse("frame")?,
         // The layer's size is at most 2^28 pixels (checked), so each side
         // fits in u32.
         width: size.width() as u32,
         height: size.height() as u32,
         spp,
-        seed: number("seed")?,
-        max_depth: field("max_depth").and_then(|(k, v)| parsed(path, &k, v))?,
+        seed: a.parse("seed")?,
+        max_depth: a.parse("max_depth")?,
         partition,
         samples,
-        invalid_samples: number("invalid_samples")?,
+        invalid_samples: a.parse("invalid_samples")?,
     })
 }
 
@@ -359,6 +365,16 @@ pub(crate) mod tests {
         let preview = crate::film::output::read_exr(&path).expect("reads as an image");
         assert_eq!(preview, film.develop());
         assert_eq!(std::fs::read_dir(dir.path()).expect("lists").count(), 1);
+        // A sample range that is not its partition's is refused.
+        let mut wrong = header(2);
+        wrong.samples = 0..8;
+        write(&path, &wrong, &film).expect("writes");
+        let e = read_header(&path).expect_err("inconsistent");
+        assert!(
+            e.to_string()
+                .ends_with("the attribute `radiant.samples` holds `0..8`, which is not valid"),
+            "{e}"
+        );
     }
 
     #[test]
