@@ -7,7 +7,8 @@
 mod common;
 
 use common::{
-    ROUNDING, arg, difference, ok, radiant, radiant_with_path, read, shot, stderr, stdout,
+    ROUNDING, arg, difference, farm_slurm, ok, radiant, radiant_with_path, read, render, shot,
+    stderr, stdout,
 };
 use std::path::{Path, PathBuf};
 
@@ -25,17 +26,12 @@ fn partitions(
         .map(|k| {
             let out = dir.join(format!("part{k}of{count}.exr"));
             let partition = format!("{k}/{count}");
-            let mut args = vec![
-                "render",
-                arg(scene),
-                "--frames",
-                "5",
-                "--partition",
-                &partition,
-            ];
-            args.extend(["-o", arg(&out), "--threads", "2"]);
-            args.extend(extra);
-            ok(&args);
+            let options = [
+                &["--partition", partition.as_str(), "--threads", "2"],
+                extra,
+            ]
+            .concat();
+            render(scene, "5", &out, &options);
             out
         })
         .collect()
@@ -55,16 +51,7 @@ fn partitions_merge_into_the_single_machine_image() {
     for sampler in ["independent", "sobol"] {
         let scene = shot(dir.path(), &format!("{sampler}.yaml"), sampler);
         let single = dir.path().join(format!("{sampler}-single.exr"));
-        ok(&[
-            "render",
-            arg(&scene),
-            "--frames",
-            "5",
-            "-o",
-            arg(&single),
-            "--threads",
-            "1",
-        ]);
+        render(&scene, "5", &single, &["--threads", "1"]);
         let mut parts = partitions(&scene, dir.path(), 3, &[2, 3, 1], &[]);
         parts.reverse();
         let merged = dir.path().join(format!("{sampler}-merged.exr"));
@@ -89,16 +76,7 @@ fn partitions_merge_into_the_single_machine_image() {
     // The tolerance has power: the same frame with another seed is far off.
     let scene = shot(dir.path(), "seeded.yaml", "independent");
     let other = dir.path().join("other-seed.exr");
-    ok(&[
-        "render",
-        arg(&scene),
-        "--frames",
-        "5",
-        "-o",
-        arg(&other),
-        "--seed",
-        "9",
-    ]);
+    render(&scene, "5", &other, &["--seed", "9"]);
     let single = dir.path().join("independent-single.exr");
     let (largest, _) = difference(&read(&other), &read(&single));
     assert!(largest > 100.0 * ROUNDING, "{largest}");
@@ -176,7 +154,7 @@ fn bad_merges_name_the_files_and_write_nothing() {
     );
     // A whole render is not a partition.
     let plain = dir.path().join("plain.exr");
-    ok(&["render", arg(&scene), "--frames", "5", "-o", arg(&plain)]);
+    render(&scene, "5", &plain, &[]);
     refused(
         &[parts[0].clone(), plain.clone()],
         &[format!(
@@ -238,21 +216,7 @@ fn farm_slurm_writes_the_scripts_and_explains_a_missing_sbatch() {
     let dir = tempfile::tempdir().unwrap();
     let scene = shot(dir.path(), "shot.yaml", "independent");
     let out = dir.path().join("frame_####.exr");
-    let base = [
-        "farm",
-        "slurm",
-        arg(&scene),
-        "-o",
-        arg(&out),
-        "--frames",
-        "1..12",
-    ];
-    fn with<'a>(base: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
-        let mut args = base.to_vec();
-        args.extend(extra);
-        args
-    }
-    let with = |extra| with(&base, extra);
+    let with = |extra| farm_slurm(&scene, &out, "1..12", extra);
     ok(&with(&[
         "--chunk",
         "5",
@@ -334,41 +298,14 @@ fn farm_status_lists_done_missing_and_partial_frames() {
     let dir = tempfile::tempdir().unwrap();
     let scene = shot(dir.path(), "shot.yaml", "independent");
     let out = dir.path().join("frame_####.exr");
-    ok(&[
-        "render",
-        arg(&scene),
-        "--frames",
-        "1..3",
-        "-o",
-        arg(&out),
-        "--spp",
-        "1",
-    ]);
-    ok(&[
-        "render",
-        arg(&scene),
-        "--frames",
-        "6",
-        "-o",
-        arg(&out),
-        "--spp",
-        "1",
-    ]);
+    render(&scene, "1..3", &out, &["--spp", "1"]);
+    render(&scene, "6", &out, &["--spp", "1"]);
     // Frame 3 cut short, frame 5 half its partitions.
     let three = dir.path().join("frame_0003.exr");
     let bytes = std::fs::read(&three).unwrap();
     std::fs::write(&three, &bytes[..bytes.len() / 2]).unwrap();
     let part = dir.path().join("frame_0005.part-1-of-2.exr");
-    ok(&[
-        "render",
-        arg(&scene),
-        "--frames",
-        "5",
-        "--partition",
-        "1/2",
-        "-o",
-        arg(&part),
-    ]);
+    render(&scene, "5", &part, &["--partition", "1/2"]);
     let listing = ok(&[
         "farm",
         "status",

@@ -11,7 +11,7 @@
 
 mod common;
 
-use common::{ROUNDING, arg, difference, ok, read, shot};
+use common::{ROUNDING, arg, difference, farm_slurm, ok, read, render, shot};
 use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -155,23 +155,21 @@ fn a_job_array_renders_a_sequence_and_its_resubmission_fills_a_killed_tasks_gap(
     std::fs::create_dir(dir.path().join("farm")).unwrap();
     let out = dir.path().join("farm/frame_####.exr");
     let frame = |f: i64| dir.path().join(format!("farm/frame_{f:04}.exr"));
-    let args = [
-        "farm",
-        "slurm",
-        arg(&scene),
-        "-o",
-        arg(&out),
-        "--frames",
+    let args = farm_slurm(
+        &scene,
+        &out,
         "1..12",
-        "--chunk",
-        "4",
-        "--cpus-per-task",
-        "1",
-        "--time",
-        "00:05:00",
-        "--spp",
-        SEQUENCE_SPP,
-    ];
+        &[
+            "--chunk",
+            "4",
+            "--cpus-per-task",
+            "1",
+            "--time",
+            "00:05:00",
+            "--spp",
+            SEQUENCE_SPP,
+        ],
+    );
     let jobs = submit(&args);
     assert_eq!(jobs.len(), 1, "{jobs:?}");
     let job = &jobs[0];
@@ -215,16 +213,7 @@ fn a_job_array_renders_a_sequence_and_its_resubmission_fills_a_killed_tasks_gap(
 
     // Every frame is the frame this machine renders.
     let local = dir.path().join("local_####.exr");
-    ok(&[
-        "render",
-        arg(&scene),
-        "--frames",
-        "1..12",
-        "-o",
-        arg(&local),
-        "--spp",
-        SEQUENCE_SPP,
-    ]);
+    render(&scene, "1..12", &local, &["--spp", SEQUENCE_SPP]);
     for f in 1..=12 {
         let here = read(&dir.path().join(format!("local_{f:04}.exr")));
         assert!(
@@ -240,21 +229,12 @@ fn a_partitioned_frame_is_merged_after_its_array_into_the_single_machine_image()
     let dir = tempfile::tempdir().unwrap();
     let scene = shot(dir.path(), "shot.yaml", "independent");
     let out = dir.path().join("frame_####.exr");
-    let jobs = submit(&[
-        "farm",
-        "slurm",
-        arg(&scene),
-        "-o",
-        arg(&out),
-        "--frames",
+    let jobs = submit(&farm_slurm(
+        &scene,
+        &out,
         "7",
-        "--partitions",
-        "4",
-        "--cpus-per-task",
-        "1",
-        "--spp",
-        "64",
-    ]);
+        &["--partitions", "4", "--cpus-per-task", "1", "--spp", "64"],
+    ));
     assert_eq!(jobs.len(), 2, "an array and a merge job: {jobs:?}");
     wait_for(&jobs);
     completed(&jobs[0], 4);
@@ -273,16 +253,7 @@ fn a_partitioned_frame_is_merged_after_its_array_into_the_single_machine_image()
     );
 
     let single = dir.path().join("single.exr");
-    ok(&[
-        "render",
-        arg(&scene),
-        "--frames",
-        "7",
-        "-o",
-        arg(&single),
-        "--spp",
-        "64",
-    ]);
+    render(&scene, "7", &single, &["--spp", "64"]);
     let (largest, same) = difference(&read(&dir.path().join("frame_0007.exr")), &read(&single));
     eprintln!(
         "merged on Slurm: largest difference {largest:e} of the peak, {same} of 1024 pixels bit-identical"

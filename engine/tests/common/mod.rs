@@ -76,6 +76,34 @@ pub fn ok(args: &[&str]) -> String {
     stdout(&o)
 }
 
+/// Renders `frames` (`A..B` or `N`) of `scene` to `out` on this machine,
+/// with `extra` options.
+pub fn render(scene: &Path, frames: &str, out: &Path, extra: &[&str]) {
+    let mut args = vec!["render", arg(scene), "--frames", frames, "-o", arg(out)];
+    args.extend(extra);
+    ok(&args);
+}
+
+/// `farm slurm SCENE -o OUT --frames FRAMES` and `extra` options.
+pub fn farm_slurm<'a>(
+    scene: &'a Path,
+    out: &'a Path,
+    frames: &'a str,
+    extra: &[&'a str],
+) -> Vec<&'a str> {
+    let mut args = vec![
+        "farm",
+        "slurm",
+        arg(scene),
+        "-o",
+        arg(out),
+        "--frames",
+        frames,
+    ];
+    args.extend(extra);
+    args
+}
+
 /// Writes the animated scene with sampler `sampler` into `dir` as `name`.
 pub fn shot(dir: &Path, name: &str, sampler: &str) -> PathBuf {
     let path = dir.join(name);
