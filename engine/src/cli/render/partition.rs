@@ -34,9 +34,9 @@ pub(super) fn run(
         );
     }
     check_output(&frame_path(&args.output, 0))?;
+    let mut scene = radiant::scene::load(&args.scene).map_err(report)?;
     let scene_bytes = std::fs::read(&args.scene)
         .map_err(|e| miette::miette!("cannot read the scene `{}`: {e}", args.scene.display()))?;
-    let mut scene = radiant::scene::load(&args.scene).map_err(report)?;
     let timeline = scene.timeline;
     let frame = frame.unwrap_or(timeline.start);
     check_frames(&args.scene, &timeline, (frame, frame))?;
