@@ -7,6 +7,7 @@
 //! frame (same estimator and sampler dimensions, time included).
 
 use glam::Vec3;
+use radiant::backend::gpu::BvhLayout;
 use radiant::extract::Overrides;
 use radiant::film::Image;
 use radiant_tests::gpu::{backend, extract_scene, render_both};
@@ -94,20 +95,20 @@ fn rays(n: usize) -> Vec<(Vec3, Vec3, f32, f32)> {
         .collect()
 }
 
-/// The GPU's closest hits and occlusion answers at each ray's time agree
-/// with the CPU's accelerator at that time, on all but a few rays (edges
-/// and ties within rounding). Distances agree to 1e-4 relative, or 1e-5
-/// absolute near the origin: the GPU makes a moving placement in f32 with
-/// its own sin and acos (the slerp) and inverts it there, the CPU in f64,
-/// which moves hits on a moving shape by up to about 5e-6.
-#[test]
-fn traversal_at_ray_times_matches_the_cpu() {
+/// The GPU's closest hits and occlusion answers at each ray's time
+/// through hierarchies of `layout` agree with the CPU's accelerator at that
+/// time, on all but a few rays (edges and ties within rounding). Distances
+/// agree to 1e-4 relative, or 1e-5 absolute near the origin: the GPU makes
+/// a moving placement in f32 with its own sin and acos (the slerp) and
+/// inverts it there, the CPU in f64, which moves hits on a moving shape by
+/// up to about 5e-6.
+fn traversal_at_ray_times_agrees(layout: BvhLayout) {
     let dir = tempfile::tempdir().expect("a temporary folder");
     let scene = extract_scene(&scene(dir.path()).to_string_lossy(), &Overrides::default());
     assert!(scene.motion_blur() && scene.stats.deforming_meshes == 1);
     let rays = rays(20_000);
     let gpu = backend()
-        .trace_rays(&scene, &rays)
+        .trace_rays(&scene, &rays, layout)
         .unwrap_or_else(|e| panic!("the GPU traces: {e}"));
     let (mut prim, mut dist, mut occl, mut hits, mut moving) = (0, 0, 0, 0, 0);
     for (&(o, d, tmax, tau), g) in rays.iter().zip(&gpu) {
@@ -127,7 +128,7 @@ fn traversal_at_ray_times_matches_the_cpu() {
         occl += usize::from(g.occluded != scene.accel.occluded_at(o, d, tmax, tau));
     }
     eprintln!(
-        "{hits} hits of {} rays ({moving} on moving or deforming shapes); mismatches: primitive {prim}, distance {dist}, occlusion {occl}",
+        "{layout:?}: {hits} hits of {} rays ({moving} on moving or deforming shapes); mismatches: primitive {prim}, distance {dist}, occlusion {occl}",
         rays.len()
     );
     assert!(hits > rays.len() / 2, "the rays should mostly hit");
@@ -137,6 +138,16 @@ fn traversal_at_ray_times_matches_the_cpu() {
         prim <= allowed && dist <= allowed && occl <= allowed,
         "GPU traversal at ray times disagrees with the CPU's: primitive {prim}, distance {dist}, occlusion {occl}"
     );
+}
+
+#[test]
+fn traversal_at_ray_times_matches_the_cpu() {
+    traversal_at_ray_times_agrees(BvhLayout::Binary);
+}
+
+#[test]
+fn wide_bvh_traversal_at_ray_times_matches_the_cpu() {
+    traversal_at_ray_times_agrees(BvhLayout::Wide);
 }
 
 /// The blurred frame renders on the GPU as on the CPU, and a 2 % energy

@@ -8,10 +8,11 @@
 //! less than the noise, which lets the tolerances catch a 2 % energy
 //! error in one module (each test also checks that it would).
 
+use radiant::backend::gpu::BvhLayout;
 use radiant::extract::Overrides;
 use radiant::film::Image;
 use radiant::settings::FilterSampling;
-use radiant_tests::gpu::render_both;
+use radiant_tests::gpu::{render_both, render_both_with_bvh};
 use radiant_tests::{Tolerances, check_against};
 
 /// Renders `scene` at `size`² pixels and `spp` on both backends and checks
@@ -37,7 +38,12 @@ fn agrees_with(
         filter_sampling: sampling,
         ..Overrides::default()
     };
-    let (gpu, cpu) = render_both(scene, &overrides);
+    judge(scene, render_both(scene, &overrides), tolerances);
+}
+
+/// Checks that the GPU image matches the CPU one within `tolerances`, and
+/// that a 2 % scale of the GPU image would not.
+fn judge(scene: &str, (gpu, cpu): (Image, Image), tolerances: Tolerances) {
     let check = check_against(&gpu, &cpu, 8);
     eprintln!("{scene}: {check:?}");
     assert!(
@@ -66,6 +72,25 @@ const CLOSE: Tolerances = Tolerances {
 #[test]
 fn cornell_box() {
     agrees("scenes/cornell-box.yaml", 48, 64, CLOSE);
+}
+
+/// The compressed wide BVH's traversal renders what the CPU renders, at
+/// the Cornell box's size and at 10⁵ times it (its error bound scales).
+#[test]
+fn wide_bvh() {
+    for scene in [
+        "scenes/cornell-box.yaml",
+        "scenes/hard/cornell-scaled-1e5.yaml",
+    ] {
+        let overrides = Overrides {
+            width: Some(48),
+            height: Some(48),
+            spp: Some(64),
+            ..Overrides::default()
+        };
+        let images = render_both_with_bvh(scene, &overrides, BvhLayout::Wide);
+        judge(scene, images, CLOSE);
+    }
 }
 
 #[test]

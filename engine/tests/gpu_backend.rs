@@ -9,7 +9,7 @@
 
 use glam::Vec3;
 use radiant::backend::gpu::probe::{Probe, ProbeKind};
-use radiant::backend::gpu::{GpuBackend, GpuError, GpuOptions};
+use radiant::backend::gpu::{BvhLayout, GpuBackend, GpuError, GpuOptions};
 use radiant::extract::{Overrides, RenderScene, extract};
 use radiant_core::{GpuModule, GpuParams, TextureTable};
 use std::path::Path;
@@ -74,13 +74,14 @@ fn rays(n: usize) -> Vec<(Vec3, Vec3, f32, f32)> {
         .collect()
 }
 
-/// The GPU's closest hits and occlusion answers agree with the CPU's on all
-/// but a few rays (those within rounding of an edge or a tie).
-fn traversal_agrees(instanced: bool) {
+/// The GPU's closest hits and occlusion answers through hierarchies of
+/// `layout` agree with the CPU's on all but a few rays (those within
+/// rounding of an edge or a tie).
+fn traversal_agrees(instanced: bool, layout: BvhLayout) {
     let scene = geometry_scene(instanced);
     assert_eq!(scene.accel.instances().len() > 1, instanced);
     let rays = rays(20_000);
-    let gpu = backend().trace_rays(&scene, &rays).unwrap();
+    let gpu = backend().trace_rays(&scene, &rays, layout).unwrap();
     let (mut prim_mismatch, mut t_mismatch, mut occlusion_mismatch, mut hits) = (0, 0, 0, 0);
     for ((o, d, tmax, _), g) in rays.iter().zip(&gpu) {
         let cpu = scene.accel.intersect(*o, *d, f32::INFINITY);
@@ -107,7 +108,7 @@ fn traversal_agrees(instanced: bool) {
         }
     }
     eprintln!(
-        "instanced {instanced}: {hits} hits of {} rays; mismatches: primitive {prim_mismatch}, distance {t_mismatch}, occlusion {occlusion_mismatch}",
+        "{layout:?}, instanced {instanced}: {hits} hits of {} rays; mismatches: primitive {prim_mismatch}, distance {t_mismatch}, occlusion {occlusion_mismatch}",
         rays.len()
     );
     assert!(hits > rays.len() * 8 / 10, "the rays should mostly hit");
@@ -121,12 +122,22 @@ fn traversal_agrees(instanced: bool) {
 
 #[test]
 fn traversal_matches_the_cpu_on_meshes_and_spheres() {
-    traversal_agrees(false);
+    traversal_agrees(false, BvhLayout::Binary);
 }
 
 #[test]
 fn traversal_matches_the_cpu_through_instances() {
-    traversal_agrees(true);
+    traversal_agrees(true, BvhLayout::Binary);
+}
+
+#[test]
+fn wide_bvh_traversal_matches_the_cpu_on_meshes_and_spheres() {
+    traversal_agrees(false, BvhLayout::Wide);
+}
+
+#[test]
+fn wide_bvh_traversal_matches_the_cpu_through_instances() {
+    traversal_agrees(true, BvhLayout::Wide);
 }
 
 #[test]

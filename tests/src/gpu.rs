@@ -6,7 +6,7 @@
 //! Without any adapter the tests fail, saying so.
 
 use radiant::backend::cpu::{Progress, render};
-use radiant::backend::gpu::{GpuBackend, GpuOptions};
+use radiant::backend::gpu::{BvhLayout, GpuBackend, GpuOptions};
 use radiant::extract::{Overrides, RenderScene, extract};
 use radiant::film::Image;
 use std::sync::{Mutex, MutexGuard, OnceLock};
@@ -36,8 +36,29 @@ pub fn extract_scene(scene: &str, overrides: &Overrides) -> RenderScene {
 /// and filter sampling (the scene's, or `overrides.filter_sampling`), so the
 /// same expectation.
 pub fn render_both(scene: &str, overrides: &Overrides) -> (Image, Image) {
+    render_both_on(&mut backend(), scene, overrides)
+}
+
+/// [`render_both`] with the GPU's hierarchies in `layout` (on an adapter
+/// opened for it).
+pub fn render_both_with_bvh(
+    scene: &str,
+    overrides: &Overrides,
+    layout: BvhLayout,
+) -> (Image, Image) {
+    let options = GpuOptions {
+        bvh: layout,
+        ..GpuOptions::default()
+    };
+    // `expect` in this test code is the assertion, as in `backend`.
+    let mut gpu = GpuBackend::new(&options)
+        .expect("a GPU adapter (install mesa-vulkan-drivers for lavapipe, as .ci/run does)");
+    render_both_on(&mut gpu, scene, overrides)
+}
+
+fn render_both_on(gpu: &mut GpuBackend, scene: &str, overrides: &Overrides) -> (Image, Image) {
     let r = extract_scene(scene, overrides);
-    let gpu = backend()
+    let gpu = gpu
         .render(&r, &Progress::none())
         .unwrap_or_else(|e| panic!("{scene}: the GPU render failed: {e}"));
     assert_eq!(

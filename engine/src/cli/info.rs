@@ -3,7 +3,7 @@
 use super::diagnostic::report;
 use clap::Args;
 use radiant::Registry;
-use radiant::backend::gpu::Plan;
+use radiant::backend::gpu::{BvhLayout, Plan};
 use radiant::extract::{Overrides, RenderScene, extract};
 use std::path::{Path, PathBuf};
 
@@ -21,6 +21,10 @@ pub struct InfoArgs {
     /// `--backend gpu`).
     #[arg(long, value_name = "DIR")]
     dump_wgsl: Option<PathBuf>,
+    /// The GPU hierarchy layout to describe: `binary` (two child boxes per
+    /// node) or `wide` (compressed wide BVH, eight children per node).
+    #[arg(long, value_enum, default_value_t = BvhLayout::Binary)]
+    gpu_bvh: BvhLayout,
 }
 
 /// The backends `radiant info` can describe.
@@ -34,8 +38,8 @@ pub enum InfoBackend {
 
 /// Prints what the GPU kernel of `r` compiles in; writes it to
 /// `dump/kernel.wgsl` if asked.
-fn gpu_kernel(r: &RenderScene, dump: Option<&Path>) -> miette::Result<()> {
-    let plan = Plan::new(r).map_err(|e| miette::miette!("{e}"))?;
+fn gpu_kernel(r: &RenderScene, bvh: BvhLayout, dump: Option<&Path>) -> miette::Result<()> {
+    let plan = Plan::with_bvh(r, bvh).map_err(|e| miette::miette!("{e}"))?;
     for (kind, types) in plan.modules.summary() {
         if !types.is_empty() {
             println!("gpu {kind:<9} {}", types.join(", "));
@@ -50,11 +54,13 @@ fn gpu_kernel(r: &RenderScene, dump: Option<&Path>) -> miette::Result<()> {
             features.join(", ")
         }
     );
+    println!("gpu bvh      {}", plan.geometry.layout);
     println!(
-        "gpu kernel   {} lines of WGSL, {} BVH nodes, {} primitives",
+        "gpu kernel   {} lines of WGSL, {} BVH nodes ({} KiB), {} primitives",
         plan.kernel.source.lines().count(),
-        plan.geometry.nodes.len(),
-        plan.geometry.prims.len() / 4
+        plan.geometry.node_count(),
+        plan.geometry.nodes.len() * 16 / 1024,
+        plan.geometry.prims.len() / plan.geometry.prim_rows()
     );
     if let Some(dir) = dump {
         std::fs::create_dir_all(dir)
@@ -178,7 +184,7 @@ pub fn run(registry: &Registry, args: &InfoArgs) -> miette::Result<()> {
         st.instances, st.instanced_shapes, st.instanced_triangles
     );
     if args.backend == InfoBackend::Gpu || args.dump_wgsl.is_some() {
-        gpu_kernel(&r, args.dump_wgsl.as_deref())?;
+        gpu_kernel(&r, args.gpu_bvh, args.dump_wgsl.as_deref())?;
     }
     Ok(())
 }

@@ -50,6 +50,11 @@ pub struct RenderArgs {
     /// tested per ray; slows rendering) and print the rays by kind.
     #[arg(long)]
     gpu_stats: bool,
+    /// On the GPU, the hierarchy layout: `binary` (two child boxes per
+    /// 64-byte node) or `wide` (compressed wide BVH: eight quantized child
+    /// boxes per 80-byte node).
+    #[arg(long, value_enum, default_value_t = radiant::backend::gpu::BvhLayout::Binary)]
+    gpu_bvh: radiant::backend::gpu::BvhLayout,
     /// Render only the K-th of N disjoint sample partitions of one frame
     /// (`3/16`) into a partial EXR file for `radiant merge`.
     #[arg(long, value_parser = clap::value_parser!(radiant::farm::partition::Partition))]
@@ -212,6 +217,7 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
                     args.backend,
                     &radiant::backend::gpu::GpuOptions {
                         stats: args.gpu_stats,
+                        bvh: args.gpu_bvh,
                         ..Default::default()
                     },
                     s,

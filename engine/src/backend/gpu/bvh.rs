@@ -1,23 +1,64 @@
-//! The GPU's hierarchy layout: obvhs binary BVHs flattened into nodes that
-//! hold both children's boxes (four `vec4f`: a child's box with its
-//! reference in `min.w` and its primitive count in `max.w`, 0 for an
-//! inner child), so that a traversal step reads one node and tests two
-//! boxes. Leaves reference runs of primitive slots.
+//! The GPU's hierarchy layouts, built from obvhs BVHs over the items'
+//! boxes (primitives of a bottom level, instances of the top level) and
+//! appended to one array of `vec4f` rows that all levels share; a level's
+//! root is a node index into it. [`BvhLayout`] picks the layout for the
+//! whole frame:
 //!
-//! The bottom levels of all meshes and the top level over instances share
-//! one node array; each level's root is an index into it.
+//! - binary: obvhs' binary BVH with up to 4 primitives per leaf, its nodes
+//!   holding both children's boxes (four rows, 64 bytes: a child's box
+//!   with its reference in `min.w` and its primitive count in `max.w`, 0
+//!   for an inner child), so that a traversal step reads one node and
+//!   tests two boxes;
+//! - wide: obvhs' compressed wide BVH ([`super::cwbvh`], five rows, 80
+//!   bytes: eight quantized child boxes).
+//!
+//! Leaves reference runs of item slots; [`Level::order`] says which item
+//! each slot holds.
 
+use super::upload::Vec4;
 use glam::Vec3A;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
+use std::fmt;
 use std::time::Duration;
 
-/// A node: four `vec4f` (see the module docs).
-pub type Node = [[f32; 4]; 4];
+/// A binary node: four rows (see the module docs).
+type Node = [Vec4; 4];
 
 /// Primitives per leaf at most.
 const MAX_LEAF: u32 = 4;
+
+/// The hierarchy layout of the GPU backend (`--gpu-bvh`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum BvhLayout {
+    /// Binary BVH, two child boxes per 64-byte node, up to 4 primitives
+    /// per leaf.
+    #[default]
+    Binary,
+    /// Compressed wide BVH (Ylitie et al. 2017): eight quantized child
+    /// boxes per 80-byte node, up to 3 primitives per leaf.
+    Wide,
+}
+
+impl BvhLayout {
+    /// `vec4f` rows per node.
+    pub fn rows_per_node(self) -> usize {
+        match self {
+            BvhLayout::Binary => 4,
+            BvhLayout::Wide => super::cwbvh::ROWS,
+        }
+    }
+}
+
+impl fmt::Display for BvhLayout {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            BvhLayout::Binary => "binary (64-byte nodes, 2 children)",
+            BvhLayout::Wide => "compressed wide (80-byte nodes, 8 children)",
+        })
+    }
+}
 
 /// A built level: where its root is and the order of its items.
 #[derive(Debug, Clone, PartialEq)]
@@ -28,14 +69,22 @@ pub struct Level {
     pub order: Vec<u32>,
 }
 
-/// Builds a binary BVH over `boxes` (one per item; `None` where an item has
-/// no finite box), appends its nodes to `nodes` and returns its root and
-/// the order of the items in its leaves; leaves reference slots from
-/// `first_slot` on.
-pub fn build_level(boxes: &[Option<Aabb>], first_slot: u32, nodes: &mut Vec<Node>) -> Level {
-    let root = nodes.len() as u32;
+/// Builds a level of `layout` over `boxes` (one per item; `None` where an
+/// item has no finite box), appends its nodes to `rows` and returns its
+/// root and the order of the items in its leaves; leaves reference slots
+/// from `first_slot` on.
+pub fn build_level(
+    boxes: &[Option<Aabb>],
+    first_slot: u32,
+    layout: BvhLayout,
+    rows: &mut Vec<Vec4>,
+) -> Level {
+    let root = (rows.len() / layout.rows_per_node()) as u32;
     if boxes.is_empty() {
-        nodes.push(node([empty_child(), empty_child()]));
+        match layout {
+            BvhLayout::Binary => rows.extend(node([empty_child(), empty_child()])),
+            BvhLayout::Wide => rows.extend(super::cwbvh::empty_node()),
+        }
         return Level {
             root,
             order: Vec::new(),
@@ -44,13 +93,24 @@ pub fn build_level(boxes: &[Option<Aabb>], first_slot: u32, nodes: &mut Vec<Node
     let somewhere = boxes.iter().flatten().next().map_or(Vec3A::ZERO, |b| b.min);
     let point = Aabb::new(somewhere, somewhere);
     let usable: Vec<Aabb> = boxes.iter().map(|b| b.unwrap_or(point)).collect();
-    let mut params = BvhBuildParams::medium_build();
-    params.max_prims_per_leaf = MAX_LEAF;
-    let bvh = obvhs::bvh2::builder::build_bvh2(&usable, params, &mut Duration::default());
-    flatten(&bvh, first_slot, nodes);
-    Level {
-        root,
-        order: bvh.primitive_indices.clone(),
+    let params = BvhBuildParams::medium_build();
+    match layout {
+        BvhLayout::Binary => {
+            let params = BvhBuildParams {
+                max_prims_per_leaf: MAX_LEAF,
+                ..params
+            };
+            let bvh = obvhs::bvh2::builder::build_bvh2(&usable, params, &mut Duration::default());
+            rows.extend(flatten(&bvh, first_slot, root).into_iter().flatten());
+            Level {
+                root,
+                order: bvh.primitive_indices.clone(),
+            }
+        }
+        BvhLayout::Wide => {
+            let order = super::cwbvh::append(&usable, &params, first_slot, rows);
+            Level { root, order }
+        }
     }
 }
 
@@ -83,19 +143,19 @@ fn node([a, b]: [Child; 2]) -> Node {
     [a[0], a[1], b[0], b[1]]
 }
 
-/// Appends the nodes of `bvh` in depth-first order (the root first).
-fn flatten(bvh: &Bvh2, first_slot: u32, nodes: &mut Vec<Node>) {
+/// The nodes of `bvh` in depth-first order (the root first), numbered
+/// from `base` on.
+fn flatten(bvh: &Bvh2, first_slot: u32, base: u32) -> Vec<Node> {
     let root = &bvh.nodes[0];
     if root.prim_count > 0 {
         // A single leaf: a node whose one child is it.
         let leaf = child(&root.aabb, first_slot + root.first_index, root.prim_count);
-        nodes.push(node([leaf, empty_child()]));
-        return;
+        return vec![node([leaf, empty_child()])];
     }
     // Depth first; each inner node's slot is filled in once its children
     // have indices.
-    let mut pending = vec![(0usize, nodes.len())];
-    nodes.push(node([empty_child(), empty_child()]));
+    let mut nodes = vec![node([empty_child(), empty_child()])];
+    let mut pending = vec![(0usize, 0usize)];
     while let Some((index, at)) = pending.pop() {
         let first = bvh.nodes[index].first_index as usize;
         let mut children = [empty_child(), empty_child()];
@@ -107,11 +167,12 @@ fn flatten(bvh: &Bvh2, first_slot: u32, nodes: &mut Vec<Node>) {
                 let slot = nodes.len();
                 nodes.push(node([empty_child(), empty_child()]));
                 pending.push((first + k, slot));
-                child(&n.aabb, slot as u32, 0)
+                child(&n.aabb, base + slot as u32, 0)
             };
         }
         nodes[at] = node(children);
     }
+    nodes
 }
 
 #[cfg(test)]
@@ -132,12 +193,13 @@ mod tests {
     fn leaves_cover_every_item_once() {
         for n in [1usize, 2, 5, 100] {
             let boxes: Vec<_> = (0..n).map(|i| unit_box(i as f32 * 2.0)).collect();
-            let mut nodes = vec![node([empty_child(), empty_child()])];
-            let level = build_level(&boxes, 10, &mut nodes);
+            let mut rows: Vec<Vec4> = node([empty_child(), empty_child()]).to_vec();
+            let level = build_level(&boxes, 10, BvhLayout::Binary, &mut rows);
+            assert_eq!(level.root, 1);
             let mut seen = vec![0; n];
             let mut stack = vec![level.root];
             while let Some(i) = stack.pop() {
-                let nd = nodes[i as usize];
+                let nd = &rows[4 * i as usize..4 * i as usize + 4];
                 for c in [0, 2] {
                     let (lo, hi) = (nd[c], nd[c + 1]);
                     let (reference, count) = (lo[3].to_bits(), hi[3].to_bits());

@@ -17,6 +17,8 @@ pub struct GpuOptions {
     /// primitives tested; slower), read with
     /// [`GpuBackend::last_stats`](super::GpuBackend::last_stats).
     pub stats: bool,
+    /// The hierarchy layout of the frames' geometry (`--gpu-bvh`).
+    pub bvh: super::BvhLayout,
 }
 
 /// Errors the device reported outside a call (validation, out of memory,

@@ -20,6 +20,7 @@ use radiant_core::{Effects, GpuLibrary};
 use std::fmt::Write;
 
 const GEOMETRY: &str = include_str!("wgsl/geometry.wgsl");
+const WIDE_BVH: &str = include_str!("wgsl/cwbvh.wgsl");
 const PATH: &str = include_str!("wgsl/path.wgsl");
 const HEADER: &str = include_str!("wgsl/header.wgsl");
 
@@ -46,6 +47,9 @@ pub struct Features {
     pub environment: bool,
     /// Counting of traversal work (`--gpu-stats`).
     pub stats: bool,
+    /// Hierarchies in the compressed wide layout (`wgsl/cwbvh.wgsl`)
+    /// rather than the binary one.
+    pub wide_bvh: bool,
     /// Samples splatted over the pixels in the filter's reach (the film's
     /// default, as the CPU and Mitsuba do) rather than placed by filter
     /// importance sampling.
@@ -65,6 +69,7 @@ impl Features {
             area_lights: modules.area_lights,
             environment: modules.environment,
             stats: false,
+            wide_bvh: geometry.layout == super::BvhLayout::Wide,
             splat: scene.settings.filter_sampling == crate::settings::FilterSampling::Splat,
         }
     }
@@ -80,6 +85,7 @@ impl Features {
             "AREA_LIGHTS" => self.area_lights,
             "ENVIRONMENT" => self.environment,
             "STATS" => self.stats,
+            "WIDE_BVH" => self.wide_bvh,
             "SPLAT" => self.splat,
             _ => return None,
         })
@@ -97,6 +103,7 @@ impl Features {
             ("area lights", self.area_lights),
             ("environment", self.environment),
             ("filter splatting", self.splat),
+            ("compressed wide BVH", self.wide_bvh),
         ]
         .into_iter()
         .filter_map(|(n, on)| on.then_some(n))
@@ -152,10 +159,7 @@ impl Kernel {
         k.part("the parameter header (wgsl/header.wgsl)", HEADER);
         k.modules(modules);
         k.part("the generated dispatchers", &dispatchers(modules));
-        k.part(
-            "the GPU backend's geometry (wgsl/geometry.wgsl)",
-            &preprocess(GEOMETRY, &features),
-        );
+        k.geometry(&features);
         k.part(
             "the GPU backend's path integrator (wgsl/path.wgsl)",
             &preprocess(PATH, &features),
@@ -209,10 +213,7 @@ impl Kernel {
             "the module prelude (radiant-core)",
             radiant_core::gpu::PRELUDE,
         );
-        k.part(
-            "the GPU backend's geometry (wgsl/geometry.wgsl)",
-            &preprocess(GEOMETRY, &features),
-        );
+        k.geometry(&features);
         k.part(
             "the tracer",
             &preprocess(
@@ -267,6 +268,21 @@ impl Kernel {
             for t in &types.types {
                 k.part(&format!("the {kind} module `{}`", t.ident), &t.wgsl);
             }
+        }
+    }
+
+    /// The backend's geometry, with the wide BVH's traversal in place of
+    /// the binary one's where the features ask for it.
+    fn geometry(&mut self, features: &Features) {
+        self.part(
+            "the GPU backend's geometry (wgsl/geometry.wgsl)",
+            &preprocess(GEOMETRY, features),
+        );
+        if features.wide_bvh {
+            self.part(
+                "the GPU backend's wide BVH traversal (wgsl/cwbvh.wgsl)",
+                &preprocess(WIDE_BVH, features),
+            );
         }
     }
 

@@ -1,8 +1,9 @@
 //! Rays traced on the GPU alone, for tests of the WGSL traversal against
 //! the CPU's BVH: closest hits and occlusion of given rays through a
-//! frame's geometry.
+//! frame's geometry, in either hierarchy layout.
 
 use super::GpuBackend;
+use super::bvh::BvhLayout;
 use super::device;
 use super::error::GpuError;
 use super::kernel::{Features, Kernel};
@@ -24,18 +25,21 @@ pub struct TracedRay {
 
 impl GpuBackend {
     /// Traces `rays` (origin, direction, tmax for the occlusion query,
-    /// time in the shutter) through `scene`'s geometry.
+    /// time in the shutter) through `scene`'s geometry laid out in
+    /// `layout`.
     pub fn trace_rays(
         &mut self,
         scene: &RenderScene,
         rays: &[(Vec3, Vec3, f32, f32)],
+        layout: BvhLayout,
     ) -> Result<Vec<TracedRay>, GpuError> {
-        let g = Geometry::new(scene)?;
+        let g = Geometry::new(scene, layout)?;
         let features = Features {
             instances: g.instanced,
             spheres: g.spheres,
             tangent_frames: g.tangent_frames,
             motion: g.motion,
+            wide_bvh: layout == BvhLayout::Wide,
             ..Features::default()
         };
         let kernel = Kernel::assemble_trace(features);

@@ -1,14 +1,15 @@
 //! The frame's geometry in the GPU's layout: primitives in leaf order of
-//! per-mesh binary BVHs, their shading data beside them, instances, the
-//! motion of what moves while the shutter is open, and the top level (see
-//! `wgsl/geometry.wgsl` for the layouts).
+//! per-mesh BVHs (binary or compressed wide, [`BvhLayout`]), their shading
+//! data beside them, instances, the motion of what moves while the shutter
+//! is open, and the top level (see `wgsl/geometry.wgsl` and
+//! `wgsl/cwbvh.wgsl` for the layouts).
 //!
 //! Primitive numbers stay those of the CPU's [`Accel`](crate::accel::Accel)
 //! (each bottom level's leaf order from its base), so the shading arrays
 //! of [`Surfaces`](crate::extract::Surfaces) are read as they are; the
 //! GPU's own leaf order is a permutation of each bottom level's slots.
 
-use super::bvh::{Node, build_level};
+use super::bvh::{BvhLayout, build_level};
 use super::error::GpuError;
 use crate::accel::{Motion, Place, Primitive};
 use crate::extract::{NO_EMITTER, NO_MATERIAL, RenderScene};
@@ -28,8 +29,11 @@ const NONE: u32 = u32::MAX;
 /// The frame's geometry, ready to upload.
 #[derive(Debug, Clone, Default)]
 pub struct Geometry {
-    /// All hierarchies' nodes (bottom levels, then the top level).
-    pub nodes: Vec<Node>,
+    /// All hierarchies' nodes (bottom levels, then the top level), as
+    /// [`BvhLayout::rows_per_node`] `vec4f` rows each.
+    pub nodes: Vec<Vec4>,
+    /// The layout of `nodes`.
+    pub layout: BvhLayout,
     /// Primitives, [`Self::prim_rows`] `vec4f` each: the shape at shutter
     /// open, its reference words, then under motion blur the shape at
     /// shutter close.
@@ -135,10 +139,16 @@ impl Geometry {
         if self.tangent_frames { 7 } else { 4 }
     }
 
-    /// Lays out the geometry of `scene`.
-    pub fn new(scene: &RenderScene) -> Result<Self, GpuError> {
+    /// The number of nodes of all hierarchies.
+    pub fn node_count(&self) -> usize {
+        self.nodes.len() / self.layout.rows_per_node()
+    }
+
+    /// Lays out the geometry of `scene` with hierarchies of `layout`.
+    pub fn new(scene: &RenderScene, layout: BvhLayout) -> Result<Self, GpuError> {
         let accel = &scene.accel;
         let mut g = Geometry {
+            layout,
             tangent_frames: scene.effects.contains(Effects::TANGENT_FRAMES),
             motion: scene.motion_blur(),
             camera_motion: NONE,
@@ -183,7 +193,7 @@ impl Geometry {
                 .collect(),
         };
         let first_slot = (self.prims.len() / self.prim_rows()) as u32;
-        let level = build_level(&boxes, first_slot, &mut self.nodes);
+        let level = build_level(&boxes, first_slot, self.layout, &mut self.nodes);
         let rows = self.shading_rows();
         for &i in &level.order {
             let id = base + i;
@@ -261,7 +271,7 @@ impl Geometry {
         }
         // The top level's leaves reference instance indices directly: its
         // order permutes the instances.
-        let level = build_level(&boxes, 0, &mut self.nodes);
+        let level = build_level(&boxes, 0, self.layout, &mut self.nodes);
         for &i in &level.order {
             let at = i as usize * INSTANCE_ROWS;
             self.instances

@@ -1,8 +1,9 @@
-// Geometry on the GPU: binary BVH traversal (closest and any hit), the two
+// Geometry on the GPU: binary BVH traversal (closest and any hit; under
+// WIDE_BVH wgsl/cwbvh.wgsl's compressed wide BVH traversal instead), the two
 // levels through instances, ray–primitive tests, and hit resolution into
 // the interaction the integrator shades (integrators/surface.rs).
 //
-// Nodes are 4 vec4f: both children's boxes, each with a reference (a node
+// Binary nodes are 4 vec4f: both children's boxes, each with a reference (a node
 // index, or the first primitive slot of a leaf) and a primitive count
 // (0: inner). An inner reference of NO_HIT is an empty child: it becomes
 // `next` and is dropped like a missed box. Primitives are PRIM_ROWS vec4f:
@@ -163,6 +164,9 @@ fn safe_inverse(d: vec3f) -> vec3f {
     return 1.0 / select(d, select(vec3f(-tiny), vec3f(tiny), d >= vec3f(0.0)), abs(d) < vec3f(tiny));
 }
 
+//#if WIDE_BVH
+// (trace_blas and trace_scene are wgsl/cwbvh.wgsl's)
+//#else
 // Traverses the bottom level at node `root`; with `any`, returns at the
 // first hit.
 fn trace_blas(root: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>, any: bool) -> bool {
@@ -235,6 +239,7 @@ fn trace_blas(root: u32, o: vec3f, d: vec3f, best: ptr<function, Hit>, any: bool
     }
     return found;
 }
+//#endif
 
 //#if INSTANCES
 // Instances are 10 vec4f: the rows of render → object, of the normal
@@ -371,6 +376,8 @@ fn instance_placement(inst: u32) -> Placement {
     return Placement(to_object, normals, to_render);
 }
 
+//#if WIDE_BVH
+//#else
 fn trace_scene(o: vec3f, d: vec3f, best: ptr<function, Hit>, any: bool) -> bool {
     let inv_d = safe_inverse(d);
     var stack: array<u32, STACK_SIZE>;
@@ -437,6 +444,7 @@ fn trace_scene(o: vec3f, d: vec3f, best: ptr<function, Hit>, any: bool) -> bool 
     }
     return found;
 }
+//#endif
 //#endif
 
 fn closest_hit(o: vec3f, d: vec3f) -> Hit {
