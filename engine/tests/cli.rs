@@ -691,25 +691,124 @@ fn a_missing_frame_of_a_deforming_mesh_fails_before_any_frame_renders() {
 /// A frame whose film does not fit under the process's memory limit is
 /// refused before rendering with what it needs and what would fit, exit
 /// code 1 (not an allocation abort's 134), and no output file.
-#[test]
-fn a_frame_larger_than_memory_is_a_clear_error() {
-    let (_dir, out) = temp("huge.exr");
-    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell-box.yaml");
-    let o = Command::new("prlimit")
-        .arg("--as=1200000000")
+/// A trivial scene: one emitting sphere seen directly (1 segment), a box
+/// filter; what a test of frame size renders fast.
+const TRIVIAL_SCENE: &str = "\
+integrator: {type: path, max_depth: 1}
+film: {width: 64, height: 64, filter: {type: box}}
+sampler: {type: independent, spp: 1}
+camera:
+  type: perspective
+  fov: 40
+  look_at: {origin: [0, 0, 4], target: [0, 0, 0], up: [0, 1, 0]}
+shapes:
+  - type: sphere
+    center: [0, 0, 0]
+    radius: 1
+    material: {type: diffuse, reflectance: 0.5}
+    emitter: {type: area, radiance: [1, 0.5, 0.25]}
+";
+
+/// Runs `radiant COMMAND TRIVIAL_SCENE ARGS…` under an address-space limit
+/// of `limit` bytes (`prlimit`), the scene written into `dir`.
+fn trivial_under_limit(dir: &Path, limit: u64, command: &str, args: &[&str]) -> Output {
+    let scene = dir.join("trivial.yaml");
+    std::fs::write(&scene, TRIVIAL_SCENE).expect("the scene is written");
+    Command::new("prlimit")
+        .arg(format!("--as={limit}"))
         .arg(env!("CARGO_BIN_EXE_radiant"))
-        .args([
-            "render", scene, "--width", "8192", "--height", "8192", "--spp", "1", "-o",
-        ])
-        .arg(&out)
+        .arg(command)
+        .arg(&scene)
+        .args(args)
         .output()
-        .expect("prlimit (util-linux) runs");
+        .expect("prlimit (util-linux) runs")
+}
+
+#[test]
+fn a_frame_larger_than_memory_renders_in_bands() {
+    // The whole film of 8192² pixels needs 1.75 GiB; under a 1.2 GB
+    // address-space limit the CPU backend renders it in bands of rows and
+    // streams them to the file.
+    let (dir, out) = temp("huge.exr");
+    let size = ["--backend", "cpu", "--width", "8192", "--height", "8192"];
+    let o = trivial_under_limit(
+        dir.path(),
+        1_200_000_000,
+        "render",
+        &[&size[..], &["-o", out.to_str().expect("a UTF-8 path")]].concat(),
+    );
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("rendered 8192x8192, 1 spp"), "{err}");
+    let image = radiant::film::output::read_exr(&out).expect("the EXR reads back");
+    assert_eq!((image.width, image.height), (8192, 8192));
+    assert!(image.pixels.iter().all(|p| p.is_finite()));
+    // The sphere is in the middle, the corners see nothing.
+    let at = |x: usize, y: usize| image.pixels[y * 8192 + x];
+    assert_eq!(at(4096, 4096).x, 1.0);
+    assert_eq!(at(0, 0).x, 0.0);
+    assert_eq!(std::fs::read_dir(dir.path()).expect("listed").count(), 2);
+}
+
+#[test]
+fn a_band_larger_than_memory_is_a_clear_error() {
+    // A band of a 32768-pixel-wide frame (with the rows on their way to the
+    // file and the encoder's blocks) needs about 70 MB, more than a 60 MB
+    // address-space limit leaves after the program itself (about 30 MB
+    // with two threads).
+    let (dir, out) = temp("huge.exr");
+    let size = [
+        "--backend",
+        "cpu",
+        "--threads",
+        "2",
+        "--width",
+        "32768",
+        "--height",
+        "32768",
+    ];
+    let o = trivial_under_limit(
+        dir.path(),
+        60_000_000,
+        "render",
+        &[&size[..], &["-o", out.to_str().expect("a UTF-8 path")]].concat(),
+    );
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("a 32768×32768 frame rendered in bands of"),
+        "{err}"
+    );
+    assert!(err.contains("GiB for the band's weighted sums"), "{err}");
+    assert!(err.contains("pixels wide"), "{err}");
+    assert!(!out.exists(), "no output may be left behind");
+    assert_eq!(std::fs::read_dir(dir.path()).expect("listed").count(), 1);
+}
+
+#[test]
+fn a_whole_film_larger_than_memory_is_a_clear_error() {
+    // The accuracy report keeps whole films: 8192² pixels need 1.75 GiB,
+    // more than a 1.2 GB address-space limit allows.
+    let (dir, report) = temp("report");
+    let args = [
+        "--width", "8192", "--height", "8192", "--budget", "1", "--out",
+    ];
+    let report = report.to_str().expect("a UTF-8 path");
+    let o = trivial_under_limit(
+        dir.path(),
+        1_200_000_000,
+        "accuracy",
+        &[&args[..], &[report]].concat(),
+    );
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("the accuracy report needs whole films in memory"),
+        "{err}"
+    );
     assert!(
         err.contains("a 8192×8192 frame needs 1.75 GiB of memory"),
         "{err}"
     );
     assert!(err.contains("rows at this width"), "{err}");
-    assert!(!out.exists(), "no output may be left behind");
 }

@@ -58,6 +58,10 @@ pub enum AccuracyError {
         /// Film width and height.
         film: (u32, u32),
     },
+    /// A film does not fit in memory (the report keeps whole films: it
+    /// compares them with the reference).
+    #[error("the accuracy report needs whole films in memory, and {0}")]
+    WholeFilm(Box<crate::film::memory::FrameTooLarge>),
     /// The GPU failed, or cannot render the scene.
     #[error(transparent)]
     Gpu(#[from] crate::backend::gpu::GpuError),

@@ -58,13 +58,17 @@ impl TwinRender {
         registry: &Registry,
         render: RenderScene,
         second_seed: u64,
-    ) -> Result<Self, SceneError> {
+    ) -> Result<Self, super::AccuracyError> {
         let other = build_sampler(scene, registry, &render, second_seed)?;
         let (w, h) = (render.settings.width, render.settings.height);
+        let whole = |e| super::AccuracyError::WholeFilm(Box::new(e));
         Ok(Self {
             scene: render,
             other,
-            films: [Film::new(w, h), Film::new(w, h)],
+            films: [
+                Film::try_new(w, h).map_err(whole)?,
+                Film::try_new(w, h).map_err(whole)?,
+            ],
             spp: 0,
             time: Duration::ZERO,
             gpu: None,

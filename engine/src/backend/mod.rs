@@ -8,9 +8,11 @@ pub mod cpu;
 pub mod gpu;
 
 use crate::extract::RenderScene;
-use crate::film::{Film, Image};
 use crate::film::memory::FrameTooLarge;
+use crate::film::output::ImageError;
+use crate::film::{Film, Image};
 use std::ops::Range;
+use std::path::Path;
 use std::time::Duration;
 use thiserror::Error;
 
@@ -57,12 +59,50 @@ pub struct Rendered {
     pub invalid_samples: u64,
 }
 
+/// A finished render written to a file: [`Rendered`] less the image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Written {
+    /// Wall time of the rendering (extract and BVH excluded).
+    pub time: Duration,
+    /// Camera paths traced (pixels × spp).
+    pub samples: u64,
+    /// Rays traced (camera, continuation and shadow rays).
+    pub rays: u64,
+    /// Samples that were NaN or infinite and recorded as zero.
+    pub invalid_samples: u64,
+}
+
+impl From<&Rendered> for Written {
+    fn from(r: &Rendered) -> Self {
+        Self {
+            time: r.time,
+            samples: r.samples,
+            rays: r.rays,
+            invalid_samples: r.invalid_samples,
+        }
+    }
+}
+
 /// Why a backend could not render a frame.
 #[derive(Debug, Error)]
 pub enum RenderError {
     /// The film does not fit in memory.
     #[error(transparent)]
     Memory(#[from] FrameTooLarge),
+    /// A backend that needs the whole film in memory cannot have it.
+    #[error(
+        "{backend} needs the whole film in memory, and {error}; the CPU backend \
+         (`--backend cpu`) holds only a band of rows"
+    )]
+    WholeFilm {
+        /// The backend, as [`Backend::describe`] says.
+        backend: String,
+        /// What the whole film needed.
+        error: FrameTooLarge,
+    },
+    /// The image file could not be written.
+    #[error(transparent)]
+    Output(#[from] ImageError),
     /// The GPU failed or cannot render the scene.
     #[error(transparent)]
     Gpu(#[from] gpu::GpuError),
@@ -89,6 +129,28 @@ pub trait Backend: Send {
         samples: Range<u32>,
         progress: &Progress<'_>,
     ) -> Result<cpu::Pass, RenderError>;
+
+    /// Renders all samples of `scene` and writes the image to `path`
+    /// (atomically: no file on failure). This default renders the whole
+    /// film, after checking that it fits in memory, and then writes it;
+    /// the CPU backend writes rows as they finish from a band of film.
+    fn write(
+        &mut self,
+        scene: &RenderScene,
+        path: &Path,
+        progress: &Progress<'_>,
+    ) -> Result<Written, RenderError> {
+        let s = &scene.settings;
+        FrameTooLarge::new(s.width, s.height)
+            .check()
+            .map_err(|error| RenderError::WholeFilm {
+                backend: self.describe(),
+                error,
+            })?;
+        let rendered = self.render(scene, progress)?;
+        crate::film::output::write(path, &rendered.image)?;
+        Ok(Written::from(&rendered))
+    }
 
     /// What the last render counted beyond [`Rendered`], as a line for
     /// the user (the GPU's rays by kind and traversal work), if anything.
@@ -122,6 +184,15 @@ impl Backend for CpuBackend {
         progress: &Progress<'_>,
     ) -> Result<cpu::Pass, RenderError> {
         Ok(cpu::render_samples(scene, film, samples, progress))
+    }
+
+    fn write(
+        &mut self,
+        scene: &RenderScene,
+        path: &Path,
+        progress: &Progress<'_>,
+    ) -> Result<Written, RenderError> {
+        cpu::write(scene, path, progress)
     }
 }
 

@@ -240,11 +240,10 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         bar.set_message(format!("frame {frame}"));
         let base = totals.frames * per_frame;
         let progress = |done: u64, _total: u64| bar.set_position(base + done);
-        let rendered = pool
-            .install(|| backend.render(s, &Progress::new(&progress)))
-            .map_err(|e| miette::miette!("{e}"))?;
         let path = frame_path(&args.output, frame);
-        radiant::film::output::write(&path, &rendered.image).map_err(|e| miette::miette!("{e}"))?;
+        let rendered = pool
+            .install(|| backend.write(s, &path, &Progress::new(&progress)))
+            .map_err(|e| miette::miette!("{e}"))?;
         if rendered.invalid_samples > 0 {
             bar.suspend(|| {
                 eprintln!(

@@ -382,6 +382,7 @@ impl SceneGeometry {
         drop(query);
         geometry.static_box = prims_box(&prims);
         if !prims.is_empty() {
+            check_bvh_memory(&scene.file, prims.len())?;
             let q = quality.unwrap_or_else(|| BuildQuality::default_for(prims.len()));
             let blas = Blas::build(&geometric(&prims), None, q);
             let shading = Shading {
@@ -431,6 +432,7 @@ impl SceneGeometry {
             note_repairs(stats, &Name(name.clone()), &geom, &mut repairs);
             let closing = closing_prims(world, entity, blur, deforming, flip);
             let meshes = deforming.then(|| mesh_pair(world, entity)).flatten();
+            check_bvh_memory(&scene.file, prims.len())?;
             let q = quality.unwrap_or_else(|| BuildQuality::default_for(prims.len()));
             let blas = Blas::build(&geometric(&prims), closing.as_deref(), q);
             let base = surfaces.material.len();
@@ -705,4 +707,24 @@ fn closing_prims(
         &mut prims,
     );
     Some(geometric(&prims))
+}
+
+/// Bytes a bottom-level BVH takes per primitive while it is built, at
+/// most (an estimate: the binary tree and its build's bounds and codes,
+/// the wide tree, the reordered primitive data and the surface tables).
+const BVH_BYTES_PER_PRIM: u64 = 512;
+
+/// An error, before anything is built, where the BVH of `prims`
+/// primitives would not fit in the memory available.
+fn check_bvh_memory(file: &std::path::Path, prims: usize) -> Result<(), SceneError> {
+    radiant_core::memory::check(prims as u64 * BVH_BYTES_PER_PRIM, || {
+        format!("the acceleration structure of {prims} primitives")
+    })
+    .map_err(|e| {
+        SceneError::new(
+            file,
+            None,
+            format!("{e}: render fewer or simpler shapes, or on a machine with more memory"),
+        )
+    })
 }

@@ -9,6 +9,8 @@
 //! filter's reach ([`FilterTable`]), or placed by filter importance
 //! sampling and added to one pixel ([`FilterSampler`], pbrt-v4).
 
+pub mod band;
+pub mod encode;
 pub mod memory;
 pub mod output;
 pub mod sheet;
@@ -273,11 +275,18 @@ fn floor_i32(x: f32) -> i32 {
     i.saturating_sub(i32::from((i as f32) > x))
 }
 
-/// The whole image's weighted sums.
+/// The weighted sums of a frame's rows: of all of them, or of a band of
+/// rows that slides down the frame as [`Film::advance`] hands finished
+/// rows on (see [`band`]).
 #[derive(Debug, Clone)]
 pub struct Film {
     width: u32,
     height: u32,
+    /// The first frame row held.
+    top: u32,
+    /// Rows held at most (all of them for a whole film).
+    band: u32,
+    /// Rows `top..top + sums.len() / width`, row-major.
     sums: Vec<Vec4>,
     /// Samples whose value was NaN or infinite (recorded as zero).
     pub invalid_samples: u64,
@@ -294,18 +303,33 @@ impl Film {
         Self::try_new(width, height).unwrap_or_else(|e| panic!("{e}"))
     }
 
-    /// An empty film, or what it needed where its memory (with that of the
-    /// image it develops into) cannot be reserved.
+    /// An empty film of the whole frame, or what it needed where its memory
+    /// (with that of the image it develops into) cannot be reserved.
     pub fn try_new(width: u32, height: u32) -> Result<Self, memory::FrameTooLarge> {
-        let pixels = width as usize * height as usize;
-        let sums = memory::try_filled(pixels, Vec4::ZERO)
-            .ok_or_else(|| memory::FrameTooLarge::new(width, height))?;
-        Ok(Self {
+        memory::FrameTooLarge::new(width, height).check()?;
+        Self::try_band(width, height, height)
+            .ok_or_else(|| memory::FrameTooLarge::new(width, height))
+    }
+
+    /// An empty film that holds `rows` rows at a time (at least one, at
+    /// most the frame's), starting with the frame's first, or `None` where
+    /// their memory cannot be reserved.
+    pub fn try_band(width: u32, height: u32, rows: u32) -> Option<Self> {
+        let band = rows.clamp(1, height.max(1));
+        let sums = memory::try_filled(band as usize * width as usize, Vec4::ZERO)?;
+        Some(Self {
             width,
             height,
+            top: 0,
+            band,
             sums,
             invalid_samples: 0,
         })
+    }
+
+    /// Rows held: `top..top + rows`.
+    fn rows(&self) -> u32 {
+        (self.sums.len() / self.width.max(1) as usize) as u32
     }
 
     /// Adds layers of per-pixel sums (Σ w·L in RGB, Σ w in alpha; each
@@ -314,8 +338,10 @@ impl Film {
     ///
     /// # Panics
     ///
-    /// If `layers` is not a whole number of layers of this film's size.
+    /// If `layers` is not a whole number of layers of this film's size, or
+    /// the film holds a band rather than the whole frame.
     pub fn add_layers(&mut self, layers: &[f32], invalid: u64) {
+        assert!(self.top == 0 && self.rows() == self.height, "a whole film");
         let layer = self.sums.len() * 4;
         assert_eq!(layers.len() % layer.max(1), 0, "not whole layers");
         for l in layers.chunks_exact(layer.max(1)) {
@@ -326,22 +352,71 @@ impl Film {
         self.invalid_samples += invalid;
     }
 
-    /// The per-pixel sums (Σ w·L in RGB, Σ w in alpha), row-major: what a
-    /// sample partition stores for `radiant merge` to add.
+    /// The sums of a whole film (Σ w·L in RGB, Σ w in alpha), row-major:
+    /// what a sample partition stores for `radiant merge` to add.
+    ///
+    /// # Panics
+    ///
+    /// If the film holds a band rather than the whole frame.
     pub fn sums(&self) -> &[Vec4] {
+        assert!(self.top == 0 && self.rows() == self.height, "a whole film");
         &self.sums
     }
 
     /// Adds a tile's sums.
+    ///
+    /// # Panics
+    ///
+    /// If the tile reaches rows the film does not hold.
     pub fn merge(&mut self, tile: &TileFilm) {
+        assert!(
+            tile.y0 as u32 >= self.top && (tile.y0 + tile.height) as u32 <= self.top + self.rows(),
+            "tile rows {}..{} outside the film's rows {}..{}",
+            tile.y0,
+            tile.y0 + tile.height,
+            self.top,
+            self.top + self.rows()
+        );
         for y in 0..tile.height {
             let src = (y * tile.width) as usize;
-            let dst = ((tile.y0 + y) as u32 * self.width + tile.x0 as u32) as usize;
+            let dst =
+                ((tile.y0 as u32 + y as u32 - self.top) * self.width + tile.x0 as u32) as usize;
             for x in 0..tile.width as usize {
                 self.sums[dst + x] += tile.sums[src + x];
             }
         }
         self.invalid_samples += tile.invalid_samples;
+    }
+
+    /// Develops the rows from the first held up to `until` (exclusive)
+    /// onto `finished`, drops them, and takes up as many new empty rows
+    /// below (as far as the frame goes) within the band's memory, which
+    /// is not reallocated. Fails, leaving the film as it was, where
+    /// `finished` cannot grow.
+    ///
+    /// # Panics
+    ///
+    /// If `until` is above the first row held or below the last.
+    pub fn advance(
+        &mut self,
+        until: u32,
+        finished: &mut Vec<Rgb>,
+    ) -> Result<(), std::collections::TryReserveError> {
+        assert!(
+            (self.top..=self.top + self.rows()).contains(&until),
+            "rows up to {until} are not held"
+        );
+        let done = (until - self.top) as usize * self.width as usize;
+        finished.try_reserve(done)?;
+        finished.extend(self.sums[..done].iter().map(develop));
+        self.sums.drain(..done);
+        self.top = until;
+        let bottom = (self.top + self.band).min(self.height);
+        self.sums.resize(
+            (bottom - self.top) as usize * self.width as usize,
+            Vec4::ZERO,
+        );
+        Ok(())
     }
 
     /// The reconstructed image: Σ w·L / Σ w per pixel.
@@ -356,23 +431,33 @@ impl Film {
 
     /// The reconstructed image, or what the frame needed where its memory
     /// cannot be reserved.
+    ///
+    /// # Panics
+    ///
+    /// If the film holds a band rather than the whole frame.
     pub fn try_develop(&self) -> Result<Image, memory::FrameTooLarge> {
+        assert!(self.top == 0 && self.rows() == self.height, "a whole film");
         let mut pixels = Vec::new();
         if pixels.try_reserve_exact(self.sums.len()).is_err() {
             return Err(memory::FrameTooLarge::new(self.width, self.height));
         }
-        pixels.extend(self.sums.iter().map(|s| {
-            if s.w > 0.0 {
-                s.truncate() / s.w
-            } else {
-                Rgb::ZERO
-            }
-        }));
+        pixels.extend(self.sums.iter().map(develop));
         Ok(Image {
             width: self.width,
             height: self.height,
             pixels,
         })
+    }
+}
+
+/// A pixel's value from its sums: Σ w·L / Σ w, black where no weight
+/// reached it.
+#[inline]
+fn develop(sum: &Vec4) -> Rgb {
+    if sum.w > 0.0 {
+        sum.truncate() / sum.w
+    } else {
+        Rgb::ZERO
     }
 }
 

@@ -1,9 +1,11 @@
 //! Image files: PNG (tone-mapped sRGB, 8 bit) and EXR (linear float RGB),
 //! written atomically: into a temporary file beside the target, then
 //! renamed over it, so an interrupted write never leaves a broken file.
+//! A whole [`Image`] is written here through the row encoders of
+//! [`super::encode`], which banded renders feed row by row.
 
 use super::Image;
-use std::io::{BufWriter, Write};
+use super::encode;
 use std::path::Path;
 
 /// Errors of reading and writing images.
@@ -22,7 +24,8 @@ pub enum ImageError {
     },
 }
 
-fn io_error(path: &Path, e: impl std::fmt::Display) -> ImageError {
+/// The error of `path` failing as `e` says.
+pub(super) fn io_error(path: &Path, e: impl std::fmt::Display) -> ImageError {
     ImageError::Io {
         path: path.display().to_string(),
         message: e.to_string(),
@@ -65,72 +68,21 @@ pub fn temp_file_beside(path: &Path, suffix: &str) -> std::io::Result<tempfile::
 
 /// Writes `image` to `path`, choosing the format by extension.
 pub fn write(path: impl AsRef<Path>, image: &Image) -> Result<(), ImageError> {
-    let path = path.as_ref();
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let format = match ext.as_deref() {
-        Some("png") => Format::Png,
-        Some("exr") => Format::Exr,
-        _ => return Err(ImageError::UnknownFormat(path.display().to_string())),
-    };
-    let mut tmp = temp_file_beside(path, ".tmp").map_err(|e| io_error(path, e))?;
-    match format {
-        Format::Png => write_png(tmp.as_file_mut(), image),
-        Format::Exr => write_exr(tmp.as_file_mut(), image),
-    }
-    .map_err(|e| io_error(path, e))?;
-    tmp.as_file().sync_all().map_err(|e| io_error(path, e))?;
-    tmp.persist(path).map_err(|e| io_error(path, e.error))?;
-    Ok(())
-}
-
-enum Format {
-    Png,
-    Exr,
+    encode::write_with(path.as_ref(), image.width, image.height, |rows| {
+        rows.write_rows(&image.pixels)
+    })
 }
 
 /// The image as PNG output shows it: clamped, sRGB-encoded, 8-bit RGB
 /// triples, row-major.
 pub fn to_srgb8(image: &Image) -> Vec<u8> {
-    image
-        .pixels
-        .iter()
-        .flat_map(|p| p.to_array())
-        .map(|c| (srgb_encode(c) * 255.0 + 0.5) as u8)
-        .collect()
+    image.pixels.iter().flat_map(|p| srgb8(*p)).collect()
 }
 
-fn write_png(file: &mut std::fs::File, image: &Image) -> Result<(), String> {
-    let bytes = to_srgb8(image);
-    let buffer = image::RgbImage::from_raw(image.width, image.height, bytes)
-        .ok_or("image size does not match its pixels")?;
-    let mut w = BufWriter::new(file);
-    buffer
-        .write_to(&mut w, image::ImageFormat::Png)
-        .map_err(|e| e.to_string())?;
-    w.flush().map_err(|e| e.to_string())
-}
-
-fn write_exr(file: &mut std::fs::File, image: &Image) -> Result<(), String> {
-    use exr::prelude::{Encoding, Layer, LayerAttributes, SpecificChannels, Vec2, WritableImage};
-    let width = image.width as usize;
-    let channels = SpecificChannels::rgb(|pos: Vec2<usize>| {
-        let p = image.pixels[pos.y() * width + pos.x()];
-        (p.x, p.y, p.z)
-    });
-    let layer = Layer::new(
-        (image.width as usize, image.height as usize),
-        LayerAttributes::named("rgb"),
-        Encoding::SMALL_LOSSLESS,
-        channels,
-    );
-    let w = BufWriter::new(file);
-    exr::image::Image::from_layer(layer)
-        .write()
-        .to_buffered(w)
-        .map_err(|e| e.to_string())
+/// A pixel as PNG output shows it: clamped, sRGB-encoded, 8 bits per
+/// channel.
+pub fn srgb8(p: radiant_core::Rgb) -> [u8; 3] {
+    p.to_array().map(|c| (srgb_encode(c) * 255.0 + 0.5) as u8)
 }
 
 /// Reads the RGB channels of an EXR file as linear floats.

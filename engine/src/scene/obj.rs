@@ -14,6 +14,12 @@ use crate::world::{MeshData, MeshRepairs};
 use glam::{DVec3, Vec2, Vec3};
 use std::path::Path;
 
+/// Bytes of memory loading an OBJ file takes per byte of the file, at most
+/// (an estimate: a face line as short as `f 1 2 3` becomes three 4-byte
+/// indices in the parser and again in the mesh, a vertex line `v 0 0 0`
+/// twelve bytes of position in each, and the mesh adds tangents).
+const MESH_BYTES_PER_FILE_BYTE: u64 = 8;
+
 /// Loads every object of an OBJ file into one mesh (materials are ignored).
 /// With `flip_tex_coords` (Mitsuba 3's default), texture coordinates are
 /// stored as (u, 1 − v): OBJ's v runs up an image, Radiant's (Mitsuba's)
@@ -95,6 +101,15 @@ fn read_obj(path: &Path, flip_tex_coords: bool) -> Result<MeshData, String> {
         .map_err(|e| format!("cannot read the mesh file: {e}"))?;
     let file = std::fs::File::open(path)
         .map_err(|e| format!("cannot open mesh file `{}`: {e}", path.display()))?;
+    let size = file.metadata().map_or(0, |m| m.len());
+    radiant_core::memory::check(size.saturating_mul(MESH_BYTES_PER_FILE_BYTE), || {
+        format!(
+            "mesh file `{}` ({}) as a mesh",
+            path.display(),
+            radiant_core::memory::gib(size)
+        )
+    })
+    .map_err(|e| e.to_string())?;
     let mut reader = LineLimit::new(std::io::BufReader::new(file), MAX_LINE);
     // Materials are ignored: an `mtllib` line loads nothing.
     let loaded = tobj::load_obj_buf(&mut reader, &options, |_| {
@@ -111,6 +126,16 @@ fn read_obj(path: &Path, flip_tex_coords: bool) -> Result<MeshData, String> {
         source: path.display().to_string(),
         ..MeshData::default()
     };
+    let vertices = models.iter().map(|m| m.mesh.positions.len() / 3).sum();
+    let triangles = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+    let reserved = mesh.positions.try_reserve_exact(vertices).is_ok()
+        && mesh.triangles.try_reserve_exact(triangles).is_ok();
+    if !reserved {
+        return Err(format!(
+            "mesh file `{}`: its {vertices} vertices and {triangles} triangles do not fit in memory",
+            path.display()
+        ));
+    }
     let mut normals = Vec::new();
     let mut uvs = Vec::new();
     let all_have_normals = models.iter().all(|m| !m.mesh.normals.is_empty());
@@ -247,5 +272,20 @@ mod tests {
             err.contains("cannot open mesh file `/nonexistent/mesh.obj`"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn an_obj_larger_than_memory_is_refused_before_reading() {
+        // A sparse file of 1 TiB: no disk space, and nothing is read.
+        let f = tempfile::Builder::new().suffix(".obj").tempfile().unwrap();
+        f.as_file().set_len(1 << 40).unwrap();
+        let start = std::time::Instant::now();
+        let err = load_obj(f.path(), true).unwrap_err();
+        assert!(
+            err.contains("(1024.00 GiB) as a mesh needs about 8192.00 GiB"),
+            "{err}"
+        );
+        assert!(err.contains("is available"), "{err}");
+        assert!(start.elapsed().as_secs_f64() < 1.0);
     }
 }

@@ -4,8 +4,9 @@
 //! their environment maps and the textures their image files.
 //!
 //! The header is read and its sizes checked before any pixel memory is
-//! reserved, so a corrupt or hostile header is an error, not an attempt to
-//! allocate hundreds of gigabytes.
+//! reserved (against a fixed bound and the memory available), so a corrupt
+//! or hostile header, or an image too large for the machine, is an error,
+//! not an attempt to allocate hundreds of gigabytes.
 
 use crate::Rgb;
 use glam::UVec2;
@@ -20,6 +21,9 @@ pub enum ExrError {
     /// The path is not a regular file (a folder, a FIFO, a device).
     #[error("{0}")]
     NotRegular(String),
+    /// The pixels would not fit in the memory available.
+    #[error(transparent)]
+    Memory(#[from] crate::memory::OutOfMemory),
     /// The `exr` crate could not read the file.
     #[error("{0}")]
     Read(#[from] exr::error::Error),
@@ -46,6 +50,13 @@ pub fn read_exr_rgb(path: &Path) -> Result<(Vec<Rgb>, UVec2), ExrError> {
         if width.checked_mul(height).is_none_or(|n| n > MAX_EXR_PIXELS) {
             return Err(ExrError::TooLarge { width, height });
         }
+    }
+    if let Some(header) = meta.headers.first() {
+        let (width, height) = (header.layer_size.width(), header.layer_size.height());
+        // The pixels as RGB floats, and a copy that a texture or
+        // environment map makes of them.
+        let needed = (width * height) as u64 * 2 * std::mem::size_of::<Rgb>() as u64;
+        crate::memory::check(needed, || format!("the {width}×{height} image"))?;
     }
     let image = read_first_rgba_layer_from_file(
         path,

@@ -32,6 +32,7 @@ pub mod gpu;
 pub mod hash;
 pub mod input_file;
 pub mod light;
+pub mod memory;
 pub mod params;
 pub mod registry;
 pub mod sampler;

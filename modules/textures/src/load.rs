@@ -95,14 +95,26 @@ fn load_exr(path: &Path) -> Result<Texels, LoadError> {
     })
 }
 
+/// Bytes per texel that decoding an integer or float image takes at most:
+/// the decoded RGBA floats, their RGB float copy and the texels.
+const DECODE_BYTES: u64 = 16 + 12 + 12;
+
 fn load_image(path: &Path, raw: bool) -> Result<Texels, LoadError> {
     radiant_core::input_file::reject_special_file(path).map_err(|e| read_error(path, e))?;
-    let decoded = image::ImageReader::open(path)
-        .map_err(|e| read_error(path, e))?
-        .with_guessed_format()
-        .map_err(|e| read_error(path, e))?
-        .decode()
+    let reader = || {
+        image::ImageReader::open(path)
+            .map_err(|e| read_error(path, e))?
+            .with_guessed_format()
+            .map_err(|e| read_error(path, e))
+    };
+    let (width, height) = reader()?
+        .into_dimensions()
         .map_err(|e| read_error(path, e))?;
+    radiant_core::memory::check(width as u64 * height as u64 * DECODE_BYTES, || {
+        format!("decoding its {width}×{height} pixels")
+    })
+    .map_err(|e| read_error(path, e))?;
+    let decoded = reader()?.decode().map_err(|e| read_error(path, e))?;
     let is_float = matches!(
         decoded.color(),
         image::ColorType::Rgb32F | image::ColorType::Rgba32F
