@@ -9,6 +9,9 @@ Usage (from the repository root):
     python3 engine/benches/gpu/gpu_bench.py --radiant target/release/radiant \
         --models ../shared/data/models --analysis [--peer ...]
 
+    python3 engine/benches/gpu/gpu_bench.py --radiant target/release/radiant \
+        --models ../shared/data/models --bvh binary,wide --scenes bunny,ogre,ogres
+
 Renders cornell.yaml and cornell-bunny.yaml (1024x1024, max_depth 8) with
 `--backend gpu`, once to warm up and then --repeat times, and prints the best
 render time (the CLI's `rendered ... in T s`: kernel time and readback, not
@@ -17,6 +20,12 @@ Mrays/s. With --peer, runs Mitsuba's script in the same run (it needs
 Mitsuba 3 with `cuda_ad_rgb` on PYTHONPATH) and prints the ratio. With
 --cpu, renders the same scenes with `--backend cpu`. Skips, saying why,
 where there is no GPU adapter or no Mitsuba.
+
+--bvh renders every GPU scene once per hierarchy layout (`--gpu-bvh`:
+binary, wide) and, with more than one, compares them: Msamples/s and the
+traversal work per ray (`--gpu-stats`: nodes visited, primitives tested).
+--scenes picks the scenes of the timed renders: cornell, bunny, ogre
+(cornell-ogre.yaml, 124k triangles), ogres (24 instances of it).
 
 --analysis instead explains the GPU time: rays by kind and traversal work
 per ray (`--gpu-stats`), render time against max_depth 1..8 (the
@@ -34,11 +43,14 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENES = [("cornell", "cornell.yaml"), ("bunny", "cornell-bunny.yaml")]
+ALL_SCENES = dict(SCENES + [("ogre", "cornell-ogre.yaml"), ("ogres", "cornell-ogres.yaml")])
 LINE = re.compile(r"rendered (\d+)x(\d+), (\d+) spp in ([0-9.]+) s \(([0-9.]+) Msamples/s, ([0-9.]+) Mrays/s\)")
 
 
-def render(radiant, scene, spp, backend, out):
+def render(radiant, scene, spp, backend, out, bvh=None):
     cmd = [radiant, "render", os.path.join(HERE, scene), "-o", out, "--spp", str(spp), "--backend", backend]
+    if bvh:
+        cmd += ["--gpu-bvh", bvh]
     p = subprocess.run(cmd, capture_output=True, text=True)
     m = LINE.search(p.stderr)
     if p.returncode != 0 or not m:
@@ -46,22 +58,51 @@ def render(radiant, scene, spp, backend, out):
     return (float(m.group(4)), float(m.group(5)), float(m.group(6))), None
 
 
-def bench(radiant, backend, spps, repeat, out):
+def bench(radiant, backend, spps, repeat, out, scenes=SCENES, bvh=None):
     results = {}
-    for name, scene in SCENES:
+    label = f"{backend} {bvh}" if bvh else backend
+    for name, scene in scenes:
         for spp in spps:
             path = os.path.join(out, f"radiant-{backend}-{name}.exr")
-            first, err = render(radiant, scene, spp, backend, path)
+            first, err = render(radiant, scene, spp, backend, path, bvh)
             if first is None:
                 print(f"skip: radiant --backend {backend} failed on {scene}: {' | '.join(err)}")
                 return None
-            runs = [render(radiant, scene, spp, backend, path)[0] for _ in range(repeat)]
+            runs = [render(radiant, scene, spp, backend, path, bvh)[0] for _ in range(repeat)]
             best = min(runs, key=lambda r: r[0])
             results[(name, spp)] = best
-            print(f"radiant {backend} {name} 1024x1024 spp {spp}: best {best[0]:.4f}s of "
+            print(f"radiant {label} {name} 1024x1024 spp {spp}: best {best[0]:.4f}s of "
                   f"{['%.4f' % r[0] for r in runs]} -> {best[1]:.1f} Msamples/s, {best[2]:.1f} Mrays/s",
                   flush=True)
     return results
+
+
+PER_RAY = re.compile(r"per ray ([0-9.]+) nodes visited, ([0-9.]+) primitives tested")
+
+
+def compare_bvh(radiant, layouts, scenes, spps, timed):
+    """Traversal work per ray of each layout (16 spp, --gpu-stats) beside the timed renders."""
+    work = {}
+    for name, scene in scenes:
+        for bvh in layouts:
+            lines = counts(radiant, scene, 16, bvh)
+            m = PER_RAY.search(lines[0]) if lines else None
+            work[(name, bvh)] = (float(m.group(1)), float(m.group(2))) if m else None
+            print(f"counts {name} {bvh} 16 spp: {lines[0] if lines else 'failed'}", flush=True)
+    base = layouts[0]
+    head = " | ".join(f"{b} Msamples/s | {b} nodes/ray | {b} prims/ray" for b in layouts)
+    print(f"\n| scene | spp | {head} | " + " | ".join(f"{b}/{base}" for b in layouts[1:]) + " |")
+    print("|---|---|" + "---|---|---|" * len(layouts) + "---|" * (len(layouts) - 1))
+    for name, _ in scenes:
+        for spp in spps:
+            cells, speed = [], {}
+            for b in layouts:
+                r = (timed.get(b) or {}).get((name, spp))
+                speed[b] = r[1] if r else None
+                w = work.get((name, b))
+                cells += [f"{r[1]:.1f}" if r else "-", f"{w[0]:.1f}" if w else "-", f"{w[1]:.1f}" if w else "-"]
+            ratios = [f"{speed[b] / speed[base]:.2f}x" if speed[b] and speed[base] else "-" for b in layouts[1:]]
+            print(f"| {name} | {spp} | " + " | ".join(cells + ratios) + " |")
 
 
 def peer(script, models, out):
@@ -80,9 +121,11 @@ def peer(script, models, out):
     return found
 
 
-def counts(radiant, scene, spp):
+def counts(radiant, scene, spp, bvh=None):
     cmd = [radiant, "render", os.path.join(HERE, scene), "-o", "/tmp/stats.exr", "--spp", str(spp),
            "--backend", "gpu", "--gpu-stats"]
+    if bvh:
+        cmd += ["--gpu-bvh", bvh]
     p = subprocess.run(cmd, capture_output=True, text=True)
     return [l for l in p.stderr.splitlines() if l.startswith("rays:")]
 
@@ -185,6 +228,8 @@ def main():
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--out", default=os.environ.get("OUT", "."))
     ap.add_argument("--analysis", action="store_true", help="explain the time instead (see above)")
+    ap.add_argument("--bvh", default="binary", help="GPU hierarchy layouts to render with: binary, wide (see above)")
+    ap.add_argument("--scenes", default="cornell,bunny", help="scenes of the timed renders: cornell, bunny, ogre, ogres")
     a = ap.parse_args()
     link = os.path.join(HERE, "models")
     if os.path.islink(link):
@@ -195,9 +240,14 @@ def main():
         analysis(a.radiant, a.peer, a.models, a.out)
         return
     spps = [int(s) for s in a.spp.split(",")]
-    gpu = bench(a.radiant, "gpu", spps, a.repeat, a.out)
+    scenes = [(n, ALL_SCENES[n]) for n in a.scenes.split(",")]
+    layouts = a.bvh.split(",")
+    timed = {b: bench(a.radiant, "gpu", spps, a.repeat, a.out, scenes, b) for b in layouts}
+    if len(layouts) > 1:
+        compare_bvh(a.radiant, layouts, scenes, spps, timed)
+    gpu = timed[layouts[0]]
     mitsuba = peer(a.peer, a.models, a.out) if a.peer else {}
-    cpu = bench(a.radiant, "cpu", spps, 1, a.out) if a.cpu else None
+    cpu = bench(a.radiant, "cpu", spps, 1, a.out, scenes) if a.cpu else None
     if gpu:
         print("\n| scene | spp | Radiant GPU Msamples/s | Mrays/s | Mitsuba cuda_ad_rgb Msamples/s | ratio | Radiant CPU Msamples/s | GPU/CPU |")
         print("|---|---|---|---|---|---|---|---|")
