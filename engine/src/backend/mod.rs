@@ -198,7 +198,7 @@ impl Backend for CpuBackend {
 
 impl Backend for gpu::GpuBackend {
     fn describe(&self) -> String {
-        format!("gpu: {}", self.adapter())
+        format!("gpu: {}, {}", self.adapter(), self.kernel())
     }
 
     fn render(
@@ -234,6 +234,14 @@ impl Backend for gpu::GpuBackend {
                 s.nodes as f64 / rays,
                 s.prims as f64 / rays
             );
+        }
+        let stages = s.stages.millis();
+        if !stages.is_empty() {
+            let times: Vec<String> = stages
+                .iter()
+                .map(|(name, ms)| format!("{name} {ms:.1} ms"))
+                .collect();
+            line += &format!("\nstages ({}): {}", self.kernel(), times.join(", "));
         }
         Some(line)
     }

@@ -3,7 +3,7 @@
 use super::diagnostic::report;
 use clap::Args;
 use radiant::Registry;
-use radiant::backend::gpu::{BvhLayout, Plan};
+use radiant::backend::gpu::{BvhLayout, GpuKernel, Plan};
 use radiant::extract::{Overrides, RenderScene, extract};
 use std::path::{Path, PathBuf};
 
@@ -25,6 +25,9 @@ pub struct InfoArgs {
     /// node) or `wide` (compressed wide BVH, eight children per node).
     #[arg(long, value_enum, default_value_t = BvhLayout::Binary)]
     gpu_bvh: BvhLayout,
+    /// The GPU kernel to describe: `megakernel` or `wavefront` (stages).
+    #[arg(long, value_enum, default_value_t = GpuKernel::Megakernel)]
+    gpu_kernel: GpuKernel,
 }
 
 /// The backends `radiant info` can describe.
@@ -38,8 +41,15 @@ pub enum InfoBackend {
 
 /// Prints what the GPU kernel of `r` compiles in; writes it to
 /// `dump/kernel.wgsl` if asked.
-fn gpu_kernel(r: &RenderScene, bvh: BvhLayout, dump: Option<&Path>) -> miette::Result<()> {
-    let plan = Plan::with_bvh(r, bvh).map_err(|e| miette::miette!("{e}"))?;
+fn gpu_kernel(
+    r: &RenderScene,
+    bvh: BvhLayout,
+    kernel: GpuKernel,
+    dump: Option<&Path>,
+) -> miette::Result<()> {
+    let plan = Plan::with_bvh(r, bvh)
+        .map_err(|e| miette::miette!("{e}"))?
+        .for_kernel(kernel, false);
     for (kind, types) in plan.modules.summary() {
         if !types.is_empty() {
             println!("gpu {kind:<9} {}", types.join(", "));
@@ -55,6 +65,7 @@ fn gpu_kernel(r: &RenderScene, bvh: BvhLayout, dump: Option<&Path>) -> miette::R
         }
     );
     println!("gpu bvh      {}", plan.geometry.layout);
+    println!("gpu paths    {kernel}");
     println!(
         "gpu kernel   {} lines of WGSL, {} BVH nodes ({} KiB), {} primitives",
         plan.kernel.source.lines().count(),
@@ -184,7 +195,7 @@ pub fn run(registry: &Registry, args: &InfoArgs) -> miette::Result<()> {
         st.instances, st.instanced_shapes, st.instanced_triangles
     );
     if args.backend == InfoBackend::Gpu || args.dump_wgsl.is_some() {
-        gpu_kernel(&r, args.gpu_bvh, args.dump_wgsl.as_deref())?;
+        gpu_kernel(&r, args.gpu_bvh, args.gpu_kernel, args.dump_wgsl.as_deref())?;
     }
     Ok(())
 }

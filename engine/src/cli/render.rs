@@ -50,6 +50,12 @@ pub struct RenderArgs {
     /// tested per ray; slows rendering) and print the rays by kind.
     #[arg(long)]
     gpu_stats: bool,
+    /// On the GPU, the kernel: `megakernel` (one invocation traces a whole
+    /// path) or `wavefront` (generate, extend, shade, connect and
+    /// accumulate stages with queues between them; with `--gpu-stats` both
+    /// print their GPU time per stage).
+    #[arg(long, value_enum, default_value_t = radiant::backend::gpu::GpuKernel::Megakernel)]
+    gpu_kernel: radiant::backend::gpu::GpuKernel,
     /// On the GPU, the hierarchy layout: `binary` (two child boxes per
     /// 64-byte node) or `wide` (compressed wide BVH: eight quantized child
     /// boxes per 80-byte node).
@@ -217,6 +223,7 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
                     args.backend,
                     &radiant::backend::gpu::GpuOptions {
                         stats: args.gpu_stats,
+                        kernel: args.gpu_kernel,
                         bvh: args.gpu_bvh,
                         ..Default::default()
                     },

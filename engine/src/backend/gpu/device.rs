@@ -19,6 +19,11 @@ pub struct GpuOptions {
     pub stats: bool,
     /// The hierarchy layout of the frames' geometry (`--gpu-bvh`).
     pub bvh: super::BvhLayout,
+    /// Which kernel renders the paths (`--gpu-kernel`).
+    pub kernel: super::GpuKernel,
+    /// Path slots of the wavefront's pool, if not its default (at most
+    /// 2^19, fewer where a batch has fewer work items).
+    pub wavefront_paths: Option<u32>,
 }
 
 /// Errors the device reported outside a call (validation, out of memory,
@@ -114,6 +119,8 @@ pub(super) fn open(
     let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
         label: Some("radiant"),
         required_limits: limits.clone(),
+        // Pass timing (`--gpu-stats`) where the adapter has it.
+        required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
         ..Default::default()
     }))
     .map_err(|e| GpuError::Device {

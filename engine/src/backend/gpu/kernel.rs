@@ -22,6 +22,7 @@ use std::fmt::Write;
 const GEOMETRY: &str = include_str!("wgsl/geometry.wgsl");
 const WIDE_BVH: &str = include_str!("wgsl/cwbvh.wgsl");
 const PATH: &str = include_str!("wgsl/path.wgsl");
+const WAVEFRONT: &str = include_str!("wgsl/wavefront.wgsl");
 const HEADER: &str = include_str!("wgsl/header.wgsl");
 
 /// Features that select blocks of the kernel's own sources.
@@ -47,6 +48,9 @@ pub struct Features {
     pub environment: bool,
     /// Counting of traversal work (`--gpu-stats`).
     pub stats: bool,
+    /// The wavefront's stages (`wgsl/wavefront.wgsl`, `--gpu-kernel
+    /// wavefront`) next to the megakernel.
+    pub wavefront: bool,
     /// Hierarchies in the compressed wide layout (`wgsl/cwbvh.wgsl`)
     /// rather than the binary one.
     pub wide_bvh: bool,
@@ -69,6 +73,7 @@ impl Features {
             area_lights: modules.area_lights,
             environment: modules.environment,
             stats: false,
+            wavefront: false,
             wide_bvh: geometry.layout == super::BvhLayout::Wide,
             splat: scene.settings.filter_sampling == crate::settings::FilterSampling::Splat,
         }
@@ -103,6 +108,7 @@ impl Features {
             ("area lights", self.area_lights),
             ("environment", self.environment),
             ("filter splatting", self.splat),
+            ("wavefront stages", self.wavefront),
             ("compressed wide BVH", self.wide_bvh),
         ]
         .into_iter()
@@ -164,6 +170,12 @@ impl Kernel {
             "the GPU backend's path integrator (wgsl/path.wgsl)",
             &preprocess(PATH, &features),
         );
+        if features.wavefront {
+            k.part(
+                "the GPU backend's wavefront stages (wgsl/wavefront.wgsl)",
+                &preprocess(WAVEFRONT, &features),
+            );
+        }
         k
     }
 

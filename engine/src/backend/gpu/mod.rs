@@ -6,9 +6,12 @@
 //! (or reuses the pipeline of an identical kernel: animation frames
 //! recompile nothing), uploads the frame's buffers, and renders the
 //! samples in dispatches small enough for OS watchdogs. One invocation
-//! traces one path (a megakernel); each owns its film or splat entry, so
-//! accumulation needs no atomics and a render is deterministic for a given
-//! seed and adapter. (Buffers are made anew each frame; keeping them, and
+//! traces one path (a megakernel), or with [`GpuKernel::Wavefront`] paths
+//! pass through separate stages with queues between them ([`wavefront`]);
+//! either way each path owns its film or splat entry, so accumulation
+//! needs no atomics and a render is deterministic for a given seed and
+//! adapter. With [`GpuOptions::stats`] every pass is timed where the
+//! adapter has timestamp queries ([`timing`]). (Buffers are made anew each frame; keeping them, and
 //! the bottom levels that did not change, is left to do.)
 
 mod bvh;
@@ -18,12 +21,16 @@ pub mod error;
 pub mod kernel;
 pub mod modules;
 pub mod probe;
+pub mod timing;
 pub mod trace;
 pub mod upload;
+pub mod wavefront;
 
 pub use bvh::BvhLayout;
 pub use device::GpuOptions;
 pub use error::GpuError;
+pub use timing::{Stage, StageTimes};
+pub use wavefront::GpuKernel;
 
 use super::cpu::Pass;
 use super::{Progress, Rendered};
@@ -33,6 +40,7 @@ use crate::integrators::path::UNLIMITED_DEPTH_CAP;
 use kernel::{Features, Kernel};
 use modules::Modules;
 use std::time::Instant;
+use timing::StageTimer;
 use upload::Geometry;
 use wgpu::util::DeviceExt;
 
@@ -112,6 +120,22 @@ impl Plan {
         Self::with_bvh(scene, BvhLayout::default())
     }
 
+    /// This plan with the kernel that renders with `kernel` (the
+    /// wavefront's stages compiled in), counting traversal work where
+    /// `stats`.
+    pub fn for_kernel(mut self, kernel: GpuKernel, stats: bool) -> Self {
+        let wavefront = kernel == GpuKernel::Wavefront;
+        if stats || wavefront {
+            let features = Features {
+                stats,
+                wavefront,
+                ..self.kernel.features
+            };
+            self.kernel = Kernel::assemble(&self.modules, features);
+        }
+        self
+    }
+
     /// [`Plan::new`] with hierarchies of `layout`.
     pub fn with_bvh(scene: &RenderScene, layout: BvhLayout) -> Result<Self, GpuError> {
         let mut modules = Modules::new(scene)?;
@@ -134,6 +158,8 @@ struct Pipeline {
     pipeline: wgpu::ComputePipeline,
     /// The gather pass of filter splatting, where the kernel splats.
     gather: Option<wgpu::ComputePipeline>,
+    /// The wavefront's stages, where the kernel has them.
+    wavefront: Option<wavefront::Stages>,
 }
 
 /// The kernel's bindings (`wgsl/path.wgsl`): the dispatch's uniform, five
@@ -190,6 +216,9 @@ pub struct GpuStats {
     pub nodes: u64,
     /// Primitives tested (zero without `stats`).
     pub prims: u64,
+    /// GPU time per stage kind (zero without `stats` or where the adapter
+    /// has no timestamp queries).
+    pub stages: StageTimes,
 }
 
 /// What the kernel of one call of [`GpuBackend::render_samples`] binds,
@@ -234,6 +263,12 @@ pub struct GpuBackend {
     stats: bool,
     /// The hierarchy layout of the frames' geometry.
     bvh: BvhLayout,
+    /// Which kernel renders.
+    kernel: GpuKernel,
+    /// Path slots of the wavefront's pool, if not its default.
+    wavefront_paths: Option<u32>,
+    /// Timestamps of the passes (with `stats`, where the adapter has them).
+    timer: Option<StageTimer>,
     last: GpuStats,
 }
 
@@ -294,10 +329,26 @@ impl GpuBackend {
     /// Opens an adapter as `options` say.
     pub fn new(options: &GpuOptions) -> Result<Self, GpuError> {
         let (device, queue, info, limits, errors) = device::open(options)?;
+        let buffers = limits.max_storage_buffers_per_shader_stage;
+        if options.kernel == GpuKernel::Wavefront && buffers < wavefront::STORAGE_BUFFERS {
+            return Err(GpuError::Limit {
+                adapter: info.name,
+                limit: "max_storage_buffers_per_shader_stage",
+                needed: wavefront::STORAGE_BUFFERS.into(),
+                allowed: buffers.into(),
+            });
+        }
         let layout = bind_group_layout(&device);
+        let timer = options
+            .stats
+            .then(|| StageTimer::new(&device, &queue))
+            .flatten();
         Ok(Self {
             stats: options.stats,
             bvh: options.bvh,
+            kernel: options.kernel,
+            wavefront_paths: options.wavefront_paths,
+            timer,
             last: GpuStats::default(),
             layout,
             device,
@@ -328,6 +379,17 @@ impl GpuBackend {
     /// What the last render counted.
     pub fn last_stats(&self) -> GpuStats {
         self.last
+    }
+
+    /// Which kernel renders.
+    pub fn kernel(&self) -> GpuKernel {
+        self.kernel
+    }
+
+    /// Whether renders time their passes (`stats` on an adapter with
+    /// timestamp queries).
+    pub fn times_stages(&self) -> bool {
+        self.timer.is_some()
     }
 
     /// Whether the adapter is a software rasteriser on the CPU (lavapipe).
@@ -378,12 +440,17 @@ impl GpuBackend {
         };
         let pipeline = entry("render");
         let gather = kernel.features.splat.then(|| entry("gather"));
+        let wavefront = kernel
+            .features
+            .wavefront
+            .then(|| wavefront::Stages::new(&self.device, &module, &self.layout, &constants));
         self.errors.check()?;
         self.pipeline = Some(Pipeline {
             source: kernel.source.clone(),
             overrides,
             pipeline,
             gather,
+            wavefront,
         });
         Ok(())
     }
@@ -451,24 +518,38 @@ impl GpuBackend {
         let pixels = w as usize * h as usize;
         let layers = ((1u64 << 20) / pixels as u64).clamp(1, MAX_LAYERS.min(spp) as u64) as u32;
         let work = dispatches(w, h, spp, layers);
-        let frame = self.upload(&plan, (w, h), layers, samples.start, &work)?;
         let total = pixels as u64 * spp as u64;
-        let start = Instant::now();
-        let counts = self.dispatch(&frame, &work, (w, h), total, progress)?;
-        let sums = device::read_f32s(
-            &self.device,
-            &self.queue,
-            &frame.film,
-            pixels * frame.film_layers * 4,
-            &self.errors,
-        )?;
-        let time = start.elapsed();
+        if let Some(timer) = &mut self.timer {
+            timer.times = StageTimes::default();
+        }
+        let (counts, (sums, time)) = match self.kernel {
+            GpuKernel::Megakernel => {
+                let frame = self.upload(&plan, (w, h), layers, samples.start, &work, 0)?;
+                let start = Instant::now();
+                let counts = self.dispatch(&frame, &work, (w, h), total, progress)?;
+                (counts, self.read_film(&frame, pixels, start)?)
+            }
+            GpuKernel::Wavefront => {
+                // The batches' uniforms follow the bands' (which the
+                // gather passes use).
+                let batches = wavefront::batches(&work, h);
+                let pool =
+                    wavefront::pool_size(pixels as u64 * layers as u64, self.wavefront_paths);
+                let slots = [&work[..], &batches].concat();
+                let frame = self.upload(&plan, (w, h), layers, samples.start, &slots, pool)?;
+                let start = Instant::now();
+                let counts =
+                    self.dispatch_wavefront(&frame, &work, &batches, pool, (w, h), progress)?;
+                (counts, self.read_film(&frame, pixels, start)?)
+            }
+        };
         self.last = GpuStats {
             camera_rays: total,
             bounce_rays: counts[1].saturating_sub(total),
             shadow_rays: counts[2],
             nodes: counts[3],
             prims: counts[4],
+            stages: self.timer.as_ref().map(|t| t.times).unwrap_or_default(),
         };
         film.add_layers(&sums, counts[0]);
         Ok(Pass {
@@ -478,17 +559,27 @@ impl GpuBackend {
         })
     }
 
+    /// Reads the film layers of `frame` back, with the time since `start`.
+    fn read_film(
+        &self,
+        frame: &FrameBuffers,
+        pixels: usize,
+        start: Instant,
+    ) -> Result<(Vec<f32>, std::time::Duration), GpuError> {
+        let sums = device::read_f32s(
+            &self.device,
+            &self.queue,
+            &frame.film,
+            pixels * frame.film_layers * 4,
+            &self.errors,
+        )?;
+        Ok((sums, start.elapsed()))
+    }
+
     /// Plans `scene` (with the traversal counters where asked) and makes
     /// sure its pipeline is compiled.
     fn compile(&mut self, scene: &RenderScene) -> Result<Plan, GpuError> {
-        let mut plan = Plan::with_bvh(scene, self.bvh)?;
-        if self.stats {
-            let features = kernel::Features {
-                stats: true,
-                ..plan.kernel.features
-            };
-            plan.kernel = Kernel::assemble(&plan.modules, features);
-        }
+        let plan = Plan::with_bvh(scene, self.bvh)?.for_kernel(self.kernel, self.stats);
         let s = &scene.settings;
         let max_depth = if s.max_depth < 0 {
             UNLIMITED_DEPTH_CAP
@@ -502,7 +593,8 @@ impl GpuBackend {
     /// The frame's buffers: `plan`'s parameters and geometry, the film
     /// (one layer when splatting, `layers` otherwise), the splatted samples
     /// (`layers` layers), the counters, and one uniform slot per dispatch
-    /// of `work` (sample indices from `first_sample` on).
+    /// of `work` (sample indices from `first_sample` on; the wavefront's
+    /// pool of `pool` path slots).
     fn upload(
         &mut self,
         plan: &Plan,
@@ -510,6 +602,7 @@ impl GpuBackend {
         layers: u32,
         first_sample: u32,
         work: &[Dispatch],
+        pool: u32,
     ) -> Result<FrameBuffers, GpuError> {
         let pixels = w as usize * h as usize;
         let splat = plan.kernel.features.splat;
@@ -531,7 +624,7 @@ impl GpuBackend {
         let mut slots = vec![0u32; work.len() * UNIFORM_STRIDE as usize / 4];
         for (k, job) in work.iter().enumerate() {
             let at = k * UNIFORM_STRIDE as usize / 4;
-            slots[at..at + 7].copy_from_slice(&[
+            slots[at..at + 8].copy_from_slice(&[
                 w,
                 h,
                 first_sample + job.first,
@@ -539,6 +632,7 @@ impl GpuBackend {
                 job.y0,
                 job.rows,
                 job.y0.saturating_sub(reach),
+                pool,
             ]);
         }
         let uniform = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -610,7 +704,7 @@ impl GpuBackend {
     /// continuation rays, shadow rays, nodes, primitives) and reporting
     /// progress towards `total` paths.
     fn dispatch(
-        &self,
+        &mut self,
         frame: &FrameBuffers,
         work: &[Dispatch],
         (w, h): (u32, u32),
@@ -618,7 +712,6 @@ impl GpuBackend {
         progress: &Progress<'_>,
     ) -> Result<[u64; 5], GpuError> {
         let compiled = self.pipeline.as_ref().expect("compiled before dispatching");
-        let (pipeline, gather) = (&compiled.pipeline, compiled.gather.as_ref());
         // Traversal counts reach 32 bits sooner than ray counts.
         let per_submit = if self.stats {
             PATHS_PER_SUBMIT >> 4
@@ -629,45 +722,75 @@ impl GpuBackend {
         while k < work.len() {
             let mut enc = self.device.create_command_encoder(&Default::default());
             let mut paths = 0u64;
-            {
-                let mut pass = enc.begin_compute_pass(&Default::default());
-                while let Some(job) = work.get(k) {
-                    let n = w as u64 * job.rows as u64 * job.samples as u64;
-                    if paths > 0 && paths + n > per_submit {
-                        break;
-                    }
-                    pass.set_pipeline(pipeline);
+            while let Some(job) = work.get(k) {
+                let n = w as u64 * job.rows as u64 * job.samples as u64;
+                if paths > 0 && paths + n > per_submit {
+                    break;
+                }
+                {
+                    let mut pass =
+                        StageTimer::pass(self.timer.as_mut(), &mut enc, Stage::Megakernel);
+                    pass.set_pipeline(&compiled.pipeline);
                     pass.set_bind_group(0, &frame.bind, &[(k as u64 * UNIFORM_STRIDE) as u32]);
                     pass.dispatch_workgroups(
                         w.div_ceil(WORKGROUP),
                         job.rows.div_ceil(WORKGROUP),
                         job.samples,
                     );
-                    if let Some(gather) = gather {
-                        // The band's rows and the filter's reach around them.
-                        let top = job.y0.saturating_sub(frame.reach);
-                        let bottom = (job.y0 + job.rows + frame.reach).min(h);
-                        pass.set_pipeline(gather);
-                        pass.dispatch_workgroups(
-                            w.div_ceil(WORKGROUP),
-                            (bottom - top).div_ceil(WORKGROUP),
-                            1,
-                        );
-                    }
-                    paths += n;
-                    k += 1;
                 }
+                if let Some(gather) = &compiled.gather {
+                    let mut pass = StageTimer::pass(self.timer.as_mut(), &mut enc, Stage::Gather);
+                    encode_gather(&mut pass, gather, frame, k, job, (w, h));
+                }
+                paths += n;
+                k += 1;
             }
-            self.queue.submit([enc.finish()]);
-            let c =
-                device::read_words(&self.device, &self.queue, &frame.counters, 5, &self.errors)?;
-            for (sum, c) in counts.iter_mut().zip(c) {
-                *sum += u64::from(c);
-            }
-            self.queue.write_buffer(&frame.counters, 0, &[0u8; 32]);
+            submit_counted(
+                (&self.device, &self.queue, &self.errors),
+                self.timer.as_mut(),
+                enc,
+                &frame.counters,
+                &mut counts,
+            )?;
             done += paths;
             progress.report(done, total);
         }
         Ok(counts)
     }
+}
+
+/// Encodes the splat gather of dispatch `k` (`job`): the band's rows and
+/// the filter's reach around them.
+fn encode_gather(
+    pass: &mut wgpu::ComputePass<'_>,
+    gather: &wgpu::ComputePipeline,
+    frame: &FrameBuffers,
+    k: usize,
+    job: &Dispatch,
+    (w, h): (u32, u32),
+) {
+    let top = job.y0.saturating_sub(frame.reach);
+    let bottom = (job.y0 + job.rows + frame.reach).min(h);
+    pass.set_pipeline(gather);
+    pass.set_bind_group(0, &frame.bind, &[(k as u64 * UNIFORM_STRIDE) as u32]);
+    pass.dispatch_workgroups(w.div_ceil(WORKGROUP), (bottom - top).div_ceil(WORKGROUP), 1);
+}
+
+/// Submits `encoder` on the device `(device, queue, errors)` (timing its
+/// passes where there is a `timer`), then adds the `counters` it counted
+/// to `counts` and zeroes them for the next submission.
+fn submit_counted(
+    (device, queue, errors): (&wgpu::Device, &wgpu::Queue, &device::ErrorSink),
+    timer: Option<&mut StageTimer>,
+    encoder: wgpu::CommandEncoder,
+    counters: &wgpu::Buffer,
+    counts: &mut [u64; 5],
+) -> Result<(), GpuError> {
+    timing::submit(device, queue, errors, timer, encoder)?;
+    let c = device::read_words(device, queue, counters, 5, errors)?;
+    for (sum, c) in counts.iter_mut().zip(c) {
+        *sum += u64::from(c);
+    }
+    queue.write_buffer(counters, 0, &[0u8; 32]);
+    Ok(())
 }

@@ -7,7 +7,8 @@
 
 // What one dispatch renders: samples [first_sample, first_sample +
 // samples) of rows [pixel_offset, pixel_offset + rows); the gather that
-// follows it (filter splatting) starts at row gather_offset.
+// follows it (filter splatting) starts at row gather_offset. The
+// wavefront (wavefront.wgsl) renders in a pool of `pool` path slots.
 struct FrameUniform {
     width: u32,
     height: u32,
@@ -16,7 +17,7 @@ struct FrameUniform {
     pixel_offset: u32,
     rows: u32,
     gather_offset: u32,
-    pad: u32,
+    pool: u32,
 }
 
 
@@ -142,10 +143,22 @@ fn sampled_point_error(p: vec3f) -> vec3f {
     return abs(p) * GAMMA7;
 }
 
-// Radiance of one camera path, and its filter weight in w (splatting: its
-// position in the pixel, packed); adds the rays
-// it traced to `rays` (camera and continuation) and `shadow_rays`.
-fn trace_path(px: u32, py: u32, index: u32, rays: ptr<function, u32>, shadow_rays: ptr<function, u32>) -> vec4f {
+// A camera path between two segments: its ray, throughput, the radiance
+// it has gathered, and what MIS and roulette need of its last bounce.
+struct PathState {
+    o: vec3f,
+    d: vec3f,
+    beta: vec3f,
+    eta_scale: f32,
+    radiance: vec3f,
+    prev_pdf: f32,
+    depth: u32,
+}
+
+// Starts sample `index` of pixel (px, py) at its camera ray (under MOTION
+// also sets ray_time, the path's time in the shutter); returns its filter
+// weight (splatting: its position in the pixel, packed).
+fn start_path(px: u32, py: u32, index: u32, path: ptr<function, PathState>) -> f32 {
     let pixel = py * frame.width + px;
 //#if SPLAT
     // Uniform in the pixel; the gather pass weights it by the filter.
@@ -170,104 +183,176 @@ fn trace_path(px: u32, py: u32, index: u32, rays: ptr<function, u32>, shadow_ray
         d = normalize(m.l * d);
     }
 //#endif
-    var beta = vec3f(ray.weight);
-    var eta_scale = 1.0;
-    var radiance = vec3f(0.0);
-    var prev_pdf = 0.0;
-    var depth = 0u;
+    *path = PathState(o, d, vec3f(ray.weight), 1.0, vec3f(0.0), 0.0, 0u);
+    return fs.z;
+}
+
+// Adds what the path's ray sees where it leaves the scene.
+fn add_escaped(path: ptr<function, PathState>) {
+//#if ENVIRONMENT
+    (*path).radiance += (*path).beta * escaped_radiance(normalize((*path).d), (*path).depth, (*path).prev_pdf);
+//#endif
+}
+
+// Adds the emission at the path's hit `it`, MIS-weighted against light
+// sampling.
+fn add_emitted(path: ptr<function, PathState>, it: Interaction) {
+//#if AREA_LIGHTS
+    if it.emitter != NO_EMITTER {
+        let e = light_hit(it.emitter, EmitterHit((*path).o, it.p, it.ng, it.emitter_prim));
+        let pmf = bitcast<f32>(light_word(it.emitter, 3u));
+        (*path).radiance += (*path).beta * e.radiance * bsdf_hit_weight((*path).depth, (*path).prev_pdf, pmf * e.pdf);
+    }
+//#endif
+}
+
+// The shading point of the hit `it` seen along d, in its local frame.
+fn shading_point(it: Interaction, d: vec3f) -> ShadingPoint {
+    return ShadingPoint(frame_to_local(it.frame, -d), it.uv, frame_to_local(it.frame, it.dp_du), frame_to_local(it.frame, it.dp_dv));
+}
+
+//#if LIGHTS
+// The shadow ray of next-event estimation: the segment origin + t·dir,
+// t in (0, 1 − SHADOW_EPSILON), and what it adds where unoccluded (zero:
+// no shadow ray).
+struct LightConnection {
+    origin: vec3f,
+    dir: vec3f,
+    value: vec3f,
+}
+
+// Next-event estimation at the path's hit `it`: a light in proportion to
+// power, a point on it, and the shadow ray towards it.
+fn connect_light(pixel: u32, index: u32, path: PathState, it: Interaction, sp: ShadingPoint) -> LightConnection {
+    let base = CAMERA_DIMS + path.depth * BOUNCE_DIMS;
+    let none = LightConnection(vec3f(0.0), vec3f(0.0), vec3f(0.0));
+    var light = 0u;
+    var light_prob = 1.0;
+    if param_u32(H_LIGHT_COUNT) > 1u {
+        let choice = select_light(sample_1d(pixel, index, base));
+        light = u32(choice.x);
+        light_prob = choice.y;
+    }
+    let ls = light_sample(light, it.p, sample_2d(pixel, index, base + 1u));
+    let to_light = ls.p - it.p;
+    let to_light_len = length(to_light);
+    var wi_world = vec3f(0.0);
+    if to_light_len > 0.0 {
+        wi_world = to_light / to_light_len;
+    }
+    let wi_local = frame_to_local(it.frame, wi_world);
+    if !(ls.pdf > 0.0 && material_has_smooth_lobes(it.material)
+        && dot(wi_world, it.ng) * wi_local.z > 0.0) {
+        return none;
+    }
+    let e = bsdf_eval(it.material, sp, wi_local);
+    if all(e.value == vec3f(0.0)) {
+        return none;
+    }
+    let light_pdf = light_prob * ls.pdf;
+    var weight = light_pdf / (light_pdf * light_pdf + e.pdf * e.pdf);
+    if light_word(light, 2u) != 0u {
+        weight = 1.0 / light_pdf;
+    }
+    let value = path.beta * e.value * ls.radiance * weight;
+    if all(value == vec3f(0.0)) || !is_finite_vec3(value) {
+        return none;
+    }
+    let origin = offset_origin(it.p, it.err, it.ng, wi_world);
+    var target_point = ls.p;
+    if any(ls.n != vec3f(0.0)) {
+        target_point = offset_origin(ls.p, sampled_point_error(ls.p), ls.n, -wi_world);
+    }
+    return LightConnection(origin, target_point - origin, value);
+}
+//#endif
+
+// Continues the path from its hit `it` by sampling the BSDF, with Russian
+// roulette; false where the path ends there.
+fn scatter(pixel: u32, index: u32, path: ptr<function, PathState>, it: Interaction, sp: ShadingPoint) -> bool {
+    let base = CAMERA_DIMS + (*path).depth * BOUNCE_DIMS;
+    let u1 = sample_1d(pixel, index, base + 3u);
+    let bs = bsdf_sample(it.material, sp, vec3f(u1, sample_2d(pixel, index, base + 4u)));
+    if bs.pdf <= 0.0 || all(bs.weight == vec3f(0.0)) {
+        return false;
+    }
+    let wi = frame_to_world(it.frame, bs.wi);
+    if dot(wi, it.ng) * bs.wi.z <= 0.0 {
+        return false;
+    }
+    var beta = (*path).beta * bs.weight;
+    let beta_max = max(beta.x, max(beta.y, beta.z));
+    if beta_max <= 0.0 || !is_finite_vec3(beta) {
+        return false;
+    }
+    let eta_scale = (*path).eta_scale * bs.eta * bs.eta;
+    let survival = beta_max * eta_scale;
+    if (*path).depth + 1u >= RR_DEPTH && survival < 1.0 {
+        if sample_1d(pixel, index, base + 6u) >= survival {
+            return false;
+        }
+        beta /= survival;
+    }
+    (*path).beta = beta;
+    (*path).eta_scale = eta_scale;
+    (*path).prev_pdf = select(bs.pdf, 0.0, bs.delta);
+    (*path).o = offset_origin(it.p, it.err, it.ng, wi);
+    (*path).d = wi;
+    (*path).depth++;
+    return true;
+}
+
+// Radiance of one camera path, and its filter weight in w (splatting: its
+// position in the pixel, packed); adds the rays
+// it traced to `rays` (camera and continuation) and `shadow_rays`.
+fn trace_path(px: u32, py: u32, index: u32, rays: ptr<function, u32>, shadow_rays: ptr<function, u32>) -> vec4f {
+    let pixel = py * frame.width + px;
+    var path: PathState;
+    let filter_weight = start_path(px, py, index, &path);
     loop {
         *rays += 1u;
-        let hit = closest_hit(o, d);
+        let hit = closest_hit(path.o, path.d);
         if hit.slot == NO_HIT {
-//#if ENVIRONMENT
-            radiance += beta * escaped_radiance(normalize(d), depth, prev_pdf);
-//#endif
+            add_escaped(&path);
             break;
         }
-        let it = interaction(hit, o, d);
-//#if AREA_LIGHTS
-        if it.emitter != NO_EMITTER {
-            let e = light_hit(it.emitter, EmitterHit(o, it.p, it.ng, it.emitter_prim));
-            let pmf = bitcast<f32>(light_word(it.emitter, 3u));
-            radiance += beta * e.radiance * bsdf_hit_weight(depth, prev_pdf, pmf * e.pdf);
-        }
-//#endif
-        if depth + 1u >= MAX_DEPTH {
+        let it = interaction(hit, path.o, path.d);
+        add_emitted(&path, it);
+        if path.depth + 1u >= MAX_DEPTH {
             break;
         }
-        let base = CAMERA_DIMS + depth * BOUNCE_DIMS;
-        let sp = ShadingPoint(frame_to_local(it.frame, -d), it.uv, frame_to_local(it.frame, it.dp_du), frame_to_local(it.frame, it.dp_dv));
-        let material = it.material;
+        let sp = shading_point(it, path.d);
 //#if LIGHTS
-        // Next-event estimation: a light in proportion to power, a point
-        // on it, and the shadow ray towards it.
-        var light = 0u;
-        var light_prob = 1.0;
-        if param_u32(H_LIGHT_COUNT) > 1u {
-            let choice = select_light(sample_1d(pixel, index, base));
-            light = u32(choice.x);
-            light_prob = choice.y;
-        }
-        let ls = light_sample(light, it.p, sample_2d(pixel, index, base + 1u));
-        let to_light = ls.p - it.p;
-        let to_light_len = length(to_light);
-        var wi_world = vec3f(0.0);
-        if to_light_len > 0.0 {
-            wi_world = to_light / to_light_len;
-        }
-        let wi_local = frame_to_local(it.frame, wi_world);
-        if ls.pdf > 0.0 && material_has_smooth_lobes(material)
-            && dot(wi_world, it.ng) * wi_local.z > 0.0 {
-            let e = bsdf_eval(material, sp, wi_local);
-            if any(e.value != vec3f(0.0)) {
-                let light_pdf = light_prob * ls.pdf;
-                var weight = light_pdf / (light_pdf * light_pdf + e.pdf * e.pdf);
-                if light_word(light, 2u) != 0u {
-                    weight = 1.0 / light_pdf;
-                }
-                let value = beta * e.value * ls.radiance * weight;
-                if any(value != vec3f(0.0)) && is_finite_vec3(value) {
-                    let origin = offset_origin(it.p, it.err, it.ng, wi_world);
-                    var target_point = ls.p;
-                    if any(ls.n != vec3f(0.0)) {
-                        target_point = offset_origin(ls.p, sampled_point_error(ls.p), ls.n, -wi_world);
-                    }
-                    *shadow_rays += 1u;
-                    if !occluded(origin, target_point - origin, 1.0 - SHADOW_EPSILON) {
-                        radiance += value;
-                    }
-                }
+        let c = connect_light(pixel, index, path, it, sp);
+        if any(c.value != vec3f(0.0)) {
+            *shadow_rays += 1u;
+            if !occluded(c.origin, c.dir, 1.0 - SHADOW_EPSILON) {
+                path.radiance += c.value;
             }
         }
 //#endif
-        let u1 = sample_1d(pixel, index, base + 3u);
-        let bs = bsdf_sample(material, sp, vec3f(u1, sample_2d(pixel, index, base + 4u)));
-        if bs.pdf <= 0.0 || all(bs.weight == vec3f(0.0)) {
+        if !scatter(pixel, index, &path, it, sp) {
             break;
         }
-        let wi = frame_to_world(it.frame, bs.wi);
-        if dot(wi, it.ng) * bs.wi.z <= 0.0 {
-            break;
-        }
-        beta *= bs.weight;
-        let beta_max = max(beta.x, max(beta.y, beta.z));
-        if beta_max <= 0.0 || !is_finite_vec3(beta) {
-            break;
-        }
-        eta_scale *= bs.eta * bs.eta;
-        let survival = beta_max * eta_scale;
-        if depth + 1u >= RR_DEPTH && survival < 1.0 {
-            if sample_1d(pixel, index, base + 6u) >= survival {
-                break;
-            }
-            beta /= survival;
-        }
-        prev_pdf = select(bs.pdf, 0.0, bs.delta);
-        o = offset_origin(it.p, it.err, it.ng, wi);
-        d = wi;
-        depth++;
     }
-    return vec4f(radiance, fs.z);
+    return vec4f(path.radiance, filter_weight);
+}
+
+// Adds one path's radiance r.xyz with filter weight r.w to film entry
+// `at` (or stores it in splat entry `at` for the gather pass); false
+// where the radiance is NaN or infinite (recorded as black).
+fn record_sample(at: u32, r: vec4f) -> bool {
+    let finite = is_finite_vec3(r.xyz);
+//#if SPLAT
+    splats[at] = vec4f(select(vec3f(0.0), r.xyz, finite), r.w);
+//#else
+    if finite {
+        film[at] += vec4f(r.xyz * r.w, r.w);
+    } else {
+        film[at].w += r.w;
+    }
+//#endif
+    return finite;
 }
 
 // Counts of the workgroup, added to the counters once: invalid samples,
@@ -294,19 +379,9 @@ fn render(@builtin(global_invocation_id) gid: vec3u, @builtin(local_invocation_i
     if in_frame {
         let r = trace_path(px, py, frame.first_sample + gid.z, &rays, &shadow_rays);
         let at = (gid.z * frame.height + py) * frame.width + px;
-        let finite = is_finite_vec3(r.xyz);
-        if !finite {
+        if !record_sample(at, r) {
             atomicAdd(&group_invalid, 1u);
         }
-//#if SPLAT
-        splats[at] = vec4f(select(vec3f(0.0), r.xyz, finite), r.w);
-//#else
-        if finite {
-            film[at] += vec4f(r.xyz * r.w, r.w);
-        } else {
-            film[at].w += r.w;
-        }
-//#endif
         atomicAdd(&group_rays, rays);
         atomicAdd(&group_shadow, shadow_rays);
 //#if STATS
