@@ -38,12 +38,10 @@ fn grid_scale(w: u32, k: u32) -> f32 {
     return bitcast<f32>(((w >> (8u * k)) & 0xffu) << 23u);
 }
 
-// Which of four children (half h of a node) the ray meets within tmax.
-// `sd` is 2^e/d, `po` is (p − o)/d, `err` bounds their rounding in t.
-fn wide_children(at: u32, h: u32, sd: vec3f, po: vec3f, neg: vec3<bool>, tmax: f32, err: f32) -> vec4<bool> {
-    let x = bitcast<vec4u>(nodes[at + 2u]);
-    let y = bitcast<vec4u>(nodes[at + 3u]);
-    let z = bitcast<vec4u>(nodes[at + 4u]);
+// Which of four children (half h of a node whose quantized planes are
+// x, y, z) the ray meets within tmax. `sd` is 2^e/d, `po` is (p − o)/d,
+// `err` bounds their rounding in t.
+fn wide_children(x: vec4u, y: vec4u, z: vec4u, h: u32, sd: vec3f, po: vec3f, neg: vec3<bool>, tmax: f32, err: f32) -> vec4<bool> {
     let lo_x = bytes4(select(x.x, x.y, h == 1u));
     let hi_x = bytes4(select(x.z, x.w, h == 1u));
     let lo_y = bytes4(select(y.x, y.y, h == 1u));
@@ -91,16 +89,20 @@ fn wide_node(node: u32, o: vec3f, inv_d: vec3f, oct: u32, tmax: f32) -> vec4u {
     let refs = bitcast<vec4u>(nodes[at + 1u]);
     let ew = bitcast<u32>(head.w);
     let scale = vec3f(grid_scale(ew, 0u), grid_scale(ew, 1u), grid_scale(ew, 2u));
-    // 2^e/d is exact; (p − o)/d and the fma round; the quantization and
-    // p + q·2^e round within an ulp of p's magnitude. Their sum bounds the
-    // error of every child's distances.
+    // 2^e/d is exact; (p − o)/d and the fma round relative to |po| and
+    // |q·sd| ≤ 255|sd|, and the conversion placed each plane within half
+    // an ulp of 255·2^e of the child's exact box (cwbvh.rs): `err`, about
+    // twice their sum, bounds the error of every child's distances.
     let sd = scale * inv_d;
     let po = (head.xyz - o) * inv_d;
-    let size = 255.0 * abs(sd) + abs(po) + abs(head.xyz * inv_d);
+    let size = 255.0 * abs(sd) + abs(po);
     let err = 2.0 * GAMMA5 * max(max(size.x, size.y), size.z);
     let neg = inv_d < vec3f(0.0);
-    let near = wide_children(at, 0u, sd, po, neg, tmax, err);
-    let far = wide_children(at, 1u, sd, po, neg, tmax, err);
+    let x = bitcast<vec4u>(nodes[at + 2u]);
+    let y = bitcast<vec4u>(nodes[at + 3u]);
+    let z = bitcast<vec4u>(nodes[at + 4u]);
+    let near = wide_children(x, y, z, 0u, sd, po, neg, tmax, err);
+    let far = wide_children(x, y, z, 1u, sd, po, neg, tmax, err);
     let hits = wide_bits(refs.z, oct, near) | wide_bits(refs.w, oct, far);
     return vec4u(refs.x, (hits & 0xff000000u) | (ew >> 24u), refs.y, hits & 0x00ffffffu);
 }
