@@ -12,6 +12,9 @@ Usage (from the repository root):
     python3 engine/benches/gpu/gpu_bench.py --radiant target/release/radiant \
         --models ../shared/data/models --bvh binary,wide --scenes bunny,ogre,ogres
 
+    python3 engine/benches/gpu/gpu_bench.py --radiant target/release/radiant \
+        --models ../shared/data/models --kernels megakernel,wavefront
+
 Renders cornell.yaml and cornell-bunny.yaml (1024x1024, max_depth 8) with
 `--backend gpu`, once to warm up and then --repeat times, and prints the best
 render time (the CLI's `rendered ... in T s`: kernel time and readback, not
@@ -26,6 +29,11 @@ binary, wide) and, with more than one, compares them: Msamples/s and the
 traversal work per ray (`--gpu-stats`: nodes visited, primitives tested).
 --scenes picks the scenes of the timed renders: cornell, bunny, ogre
 (cornell-ogre.yaml, 124k triangles), ogres (24 instances of it).
+
+--kernels renders every GPU scene once per GPU kernel (`--gpu-kernel`:
+megakernel, wavefront; the first layout of --bvh) and, with more than one,
+compares them: Msamples/s, and the GPU time per stage of one 16-spp render
+each (`--gpu-stats`: `stages (KERNEL): generate … ms, extend …`).
 
 --analysis instead explains the GPU time: rays by kind and traversal work
 per ray (`--gpu-stats`), render time against max_depth 1..8 (the
@@ -47,10 +55,12 @@ ALL_SCENES = dict(SCENES + [("ogre", "cornell-ogre.yaml"), ("ogres", "cornell-og
 LINE = re.compile(r"rendered (\d+)x(\d+), (\d+) spp in ([0-9.]+) s \(([0-9.]+) Msamples/s, ([0-9.]+) Mrays/s\)")
 
 
-def render(radiant, scene, spp, backend, out, bvh=None):
+def render(radiant, scene, spp, backend, out, bvh=None, kernel=None):
     cmd = [radiant, "render", os.path.join(HERE, scene), "-o", out, "--spp", str(spp), "--backend", backend]
     if bvh:
         cmd += ["--gpu-bvh", bvh]
+    if kernel:
+        cmd += ["--gpu-kernel", kernel]
     p = subprocess.run(cmd, capture_output=True, text=True)
     m = LINE.search(p.stderr)
     if p.returncode != 0 or not m:
@@ -58,17 +68,17 @@ def render(radiant, scene, spp, backend, out, bvh=None):
     return (float(m.group(4)), float(m.group(5)), float(m.group(6))), None
 
 
-def bench(radiant, backend, spps, repeat, out, scenes=SCENES, bvh=None):
+def bench(radiant, backend, spps, repeat, out, scenes=SCENES, bvh=None, kernel=None):
     results = {}
-    label = f"{backend} {bvh}" if bvh else backend
+    label = " ".join(x for x in [backend, bvh, kernel] if x)
     for name, scene in scenes:
         for spp in spps:
             path = os.path.join(out, f"radiant-{backend}-{name}.exr")
-            first, err = render(radiant, scene, spp, backend, path, bvh)
+            first, err = render(radiant, scene, spp, backend, path, bvh, kernel)
             if first is None:
                 print(f"skip: radiant --backend {backend} failed on {scene}: {' | '.join(err)}")
                 return None
-            runs = [render(radiant, scene, spp, backend, path, bvh)[0] for _ in range(repeat)]
+            runs = [render(radiant, scene, spp, backend, path, bvh, kernel)[0] for _ in range(repeat)]
             best = min(runs, key=lambda r: r[0])
             results[(name, spp)] = best
             print(f"radiant {label} {name} 1024x1024 spp {spp}: best {best[0]:.4f}s of "
@@ -121,13 +131,33 @@ def peer(script, models, out):
     return found
 
 
-def counts(radiant, scene, spp, bvh=None):
+def counts(radiant, scene, spp, bvh=None, kernel=None):
     cmd = [radiant, "render", os.path.join(HERE, scene), "-o", "/tmp/stats.exr", "--spp", str(spp),
            "--backend", "gpu", "--gpu-stats"]
     if bvh:
         cmd += ["--gpu-bvh", bvh]
+    if kernel:
+        cmd += ["--gpu-kernel", kernel]
     p = subprocess.run(cmd, capture_output=True, text=True)
-    return [l for l in p.stderr.splitlines() if l.startswith("rays:")]
+    return [l for l in p.stderr.splitlines() if l.startswith(("rays:", "stages"))]
+
+
+def compare_kernels(radiant, kernels, scenes, spps, timed, bvh):
+    """Msamples/s of each GPU kernel, and GPU time per stage of one 16-spp render each."""
+    for name, scene in scenes:
+        for kernel in kernels:
+            for line in counts(radiant, scene, 16, bvh, kernel):
+                print(f"counts {name} {kernel} 16 spp: {line}", flush=True)
+    base = kernels[0]
+    print("\n| scene | spp | " + " | ".join(f"{k} Msamples/s" for k in kernels) + " | "
+          + " | ".join(f"{k}/{base}" for k in kernels[1:]) + " |")
+    print("|---|---|" + "---|" * (2 * len(kernels) - 1))
+    for name, _ in scenes:
+        for spp in spps:
+            speed = {k: ((timed.get(k) or {}).get((name, spp)) or (None, None))[1] for k in kernels}
+            cells = [f"{speed[k]:.1f}" if speed[k] else "-" for k in kernels]
+            ratios = [f"{speed[k] / speed[base]:.2f}x" if speed[k] and speed[base] else "-" for k in kernels[1:]]
+            print(f"| {name} | {spp} | " + " | ".join(cells + ratios) + " |")
 
 
 def read_exr(path):
@@ -230,6 +260,7 @@ def main():
     ap.add_argument("--analysis", action="store_true", help="explain the time instead (see above)")
     ap.add_argument("--bvh", default="binary", help="GPU hierarchy layouts to render with: binary, wide (see above)")
     ap.add_argument("--scenes", default="cornell,bunny", help="scenes of the timed renders: cornell, bunny, ogre, ogres")
+    ap.add_argument("--kernels", default="megakernel", help="GPU kernels to render with: megakernel, wavefront (see above)")
     a = ap.parse_args()
     link = os.path.join(HERE, "models")
     if os.path.islink(link):
@@ -242,9 +273,16 @@ def main():
     spps = [int(s) for s in a.spp.split(",")]
     scenes = [(n, ALL_SCENES[n]) for n in a.scenes.split(",")]
     layouts = a.bvh.split(",")
-    timed = {b: bench(a.radiant, "gpu", spps, a.repeat, a.out, scenes, b) for b in layouts}
+    kernels = a.kernels.split(",")
+    first = None if kernels[0] == "megakernel" else kernels[0]
+    timed = {b: bench(a.radiant, "gpu", spps, a.repeat, a.out, scenes, b, first) for b in layouts}
     if len(layouts) > 1:
         compare_bvh(a.radiant, layouts, scenes, spps, timed)
+    if len(kernels) > 1:
+        by_kernel = {kernels[0]: timed[layouts[0]]}
+        for k in kernels[1:]:
+            by_kernel[k] = bench(a.radiant, "gpu", spps, a.repeat, a.out, scenes, layouts[0], k)
+        compare_kernels(a.radiant, kernels, scenes, spps, by_kernel, layouts[0])
     gpu = timed[layouts[0]]
     mitsuba = peer(a.peer, a.models, a.out) if a.peer else {}
     cpu = bench(a.radiant, "cpu", spps, 1, a.out, scenes) if a.cpu else None
