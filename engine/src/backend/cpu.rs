@@ -143,10 +143,9 @@ pub fn render_samples(
 /// Renders every sample of `scene` in groups of `group` tile rows and
 /// hands the developed rows, top to bottom, to `rows`, holding only the
 /// film rows a group reaches: the image of [`render`], bit for bit, since
-/// tiles are rendered and merged exactly as there. Each group is merged,
-/// and its finished rows developed and encoded, while the next group
-/// renders. Fails before any sample is traced where the band does not fit
-/// in memory.
+/// tiles are rendered and merged exactly as there. Each group's finished
+/// rows are encoded while the next group renders. Fails before any sample
+/// is traced where the band does not fit in memory.
 pub fn render_rows(
     scene: &RenderScene,
     rows: &mut dyn RowSink,
@@ -170,32 +169,22 @@ pub fn render_rows(
     finished
         .try_reserve_exact(bands.rows() as usize * s.width as usize)
         .map_err(|_| too_large())?;
-    // Group k renders while group k − 1 is merged, its finished rows
-    // developed and encoded: the film and the file are touched by one
-    // side only, and tiles are merged in tile order as ever.
-    let mut finish = |tiles: Vec<TileFilm>, group: &Range<u32>| -> Result<(), RenderError> {
+    let mut rays = 0;
+    for group in bands.groups() {
+        let ((tiles, r), written) = rayon::join(
+            || tiler.render(group.clone()),
+            || rows.write_rows(&finished),
+        );
+        written?;
+        finished.clear();
         for tile in &tiles {
             film.merge(tile);
         }
-        finished.clear();
-        film.advance(bands.finished(group), &mut finished)
-            .map_err(|_| too_large())?;
-        Ok(rows.write_rows(&finished)?)
-    };
-    let mut rays = 0;
-    let mut rendered: Option<(Vec<TileFilm>, Range<u32>)> = None;
-    for group in bands.groups() {
-        let ((tiles, r), done) = rayon::join(
-            || tiler.render(group.clone()),
-            || rendered.take().map_or(Ok(()), |(t, g)| finish(t, &g)),
-        );
-        done?;
         rays += r;
-        rendered = Some((tiles, group));
+        film.advance(bands.finished(&group), &mut finished)
+            .map_err(|_| too_large())?;
     }
-    if let Some((tiles, group)) = rendered {
-        finish(tiles, &group)?;
-    }
+    rows.write_rows(&finished)?;
     Ok(Written {
         time: start.elapsed(),
         samples: tiler.total,
@@ -354,7 +343,7 @@ mod tests {
                 rows.pixels == whole.image.pixels,
                 "groups of {group} tile rows"
             );
-            assert_eq!(rows.calls, 4usize.div_ceil(group as usize));
+            assert_eq!(rows.calls, 4usize.div_ceil(group as usize) + 1);
             assert_eq!(written.rays, whole.rays);
             assert_eq!(written.samples, whole.samples);
         }

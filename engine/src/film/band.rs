@@ -80,8 +80,7 @@ impl Bands {
                     "finished rows on their way to the file",
                     w * rows * IMAGE_BYTES,
                 ),
-                // A group's tiles render while the last group's merge.
-                ("the tiles in flight", 2 * tiles * tile_pixels * SUM_BYTES),
+                ("the tiles in flight", tiles * tile_pixels * SUM_BYTES),
                 (
                     "the encoder",
                     encode::buffer_bytes(self.width, self.rows(), threads),
