@@ -752,8 +752,9 @@ fn a_frame_larger_than_memory_renders_in_bands() {
 
 #[test]
 fn a_band_larger_than_memory_is_a_clear_error() {
-    // A band of a 32768-pixel-wide frame (with the rows on their way to the
-    // file and the encoder's blocks) needs about 70 MB, more than a 60 MB
+    // A band of a 32768-pixel-wide frame (one tile row with the filter's
+    // border, the rows on their way to the file, a group of tiles and the
+    // encoder's blocks) needs about 75 MB, more than a 60 MB
     // address-space limit leaves after the program itself (about 30 MB
     // with two threads).
     let (dir, out) = temp("huge.exr");
