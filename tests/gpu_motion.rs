@@ -173,9 +173,11 @@ fn motion_blurred_frame_matches_the_cpu() {
     }
 }
 
-/// Frames reuse what did not change on the device: a camera move keeps the
-/// geometry's buffers (one upload for two frames), a moving shape uploads
-/// its frame's geometry.
+/// Frames reuse what did not change: a camera move keeps the geometry's
+/// buffers (one upload for two frames) and lays out no bottom level again;
+/// a moving shape and a deforming mesh upload their frame's geometry, and
+/// only the deforming mesh's bottom level (and any after it whose place in
+/// the arrays moved) is laid out again.
 #[test]
 fn frames_upload_only_changed_geometry() {
     use radiant::backend::cpu::Progress;
@@ -199,13 +201,24 @@ fn frames_upload_only_changed_geometry() {
             Sequence::new(&mut loaded, &registry, &Overrides::default(), &options, 1)
                 .expect("the scene extracts");
         let before = gpu.geometry_uploads();
+        let built = gpu.levels_built();
         gpu.render(sequence.scene(), &Progress::none())
             .expect("frame 1 renders");
+        let first = gpu.levels_built() - built;
+        let levels = sequence.scene().accel.blases().len() as u64;
         sequence
             .go_to(&mut loaded, &registry, 2)
             .expect("frame 2 extracts");
         gpu.render(sequence.scene(), &Progress::none())
             .expect("frame 2 renders");
+        let second = gpu.levels_built() - built - first;
+        eprintln!("{levels} bottom levels: frame 1 laid out {first}, frame 2 {second}");
         assert_eq!(gpu.geometry_uploads() - before, uploads);
+        assert_eq!(first, levels, "a new scene lays out every level");
+        if uploads == 1 {
+            assert_eq!(second, 0, "a camera move lays out no level again");
+        } else {
+            assert!((1..levels).contains(&second), "frame 2 laid out {second}");
+        }
     }
 }

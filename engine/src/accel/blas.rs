@@ -47,6 +47,15 @@ pub struct Blas {
     closing: Option<Closing>,
     /// Per leaf-order index, the index of the primitive in the input.
     order: Vec<u32>,
+    /// See [`Blas::version`].
+    version: u64,
+}
+
+/// The next [`Blas::version`].
+static NEXT_VERSION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+
+fn next_version() -> u64 {
+    NEXT_VERSION.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 impl Blas {
@@ -75,6 +84,7 @@ impl Blas {
         self.closing = close.map(|close| closing(close, &order, &packets));
         self.packets = packets;
         self.order = order;
+        self.version = next_version();
     }
 
     /// Follows primitives that moved: `prims` (and `close`, as in
@@ -112,10 +122,18 @@ impl Blas {
             .map(|&i| prims[i as usize])
             .collect_into_vec(&mut self.prims);
         self.closing = close.map(|close| closing(close, &self.order, &self.packets));
+        self.version = next_version();
         Update {
             time: start.elapsed(),
             ..update
         }
+    }
+
+    /// A number that changes whenever the primitives or the hierarchy do
+    /// (a build, a refit, a rebuild), unique among the bottom levels of the
+    /// process: what a copy of the level elsewhere (the GPU's) is keyed by.
+    pub fn version(&self) -> u64 {
+        self.version
     }
 
     /// Per leaf-order index, the index of the primitive in the input of the

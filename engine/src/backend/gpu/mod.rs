@@ -41,7 +41,7 @@ use kernel::{Features, Kernel};
 use modules::Modules;
 use std::time::Instant;
 use timing::StageTimer;
-use upload::Geometry;
+use upload::{Geometry, LevelCache};
 use wgpu::util::DeviceExt;
 
 /// Paths (pixels × samples) one dispatch renders at most, so that each
@@ -138,8 +138,18 @@ impl Plan {
 
     /// [`Plan::new`] with hierarchies of `layout`.
     pub fn with_bvh(scene: &RenderScene, layout: BvhLayout) -> Result<Self, GpuError> {
+        Self::with_levels(scene, layout, &mut LevelCache::default())
+    }
+
+    /// [`Plan::with_bvh`], taking the bottom levels that did not change
+    /// since the last frame from `levels`.
+    pub fn with_levels(
+        scene: &RenderScene,
+        layout: BvhLayout,
+        levels: &mut LevelCache,
+    ) -> Result<Self, GpuError> {
         let mut modules = Modules::new(scene)?;
-        let geometry = Geometry::new(scene, layout)?;
+        let geometry = Geometry::with_cache(scene, layout, levels)?;
         modules.locate(&geometry);
         let features = Features::of(scene, &geometry, &modules);
         let kernel = Kernel::assemble(&modules, features);
@@ -255,6 +265,8 @@ pub struct GpuBackend {
     pipeline: Option<Pipeline>,
     /// The last frame's geometry buffers.
     geometry: Option<ResidentGeometry>,
+    /// The last frame's bottom levels in the GPU's layout.
+    levels: LevelCache,
     /// Geometry uploads so far (a frame whose geometry is the last one's
     /// uploads none).
     uploads: u64,
@@ -357,6 +369,7 @@ impl GpuBackend {
             limits,
             pipeline: None,
             geometry: None,
+            levels: LevelCache::default(),
             uploads: 0,
             errors,
         })
@@ -374,6 +387,13 @@ impl GpuBackend {
     /// geometry is the same as the last one's reuse its buffers.
     pub fn geometry_uploads(&self) -> u64 {
         self.uploads
+    }
+
+    /// How many bottom levels were laid out for the GPU: a frame lays out
+    /// only those that changed since the last frame (or moved in the
+    /// arrays), and reuses the rest.
+    pub fn levels_built(&self) -> u64 {
+        self.levels.built()
     }
 
     /// What the last render counted.
@@ -579,7 +599,8 @@ impl GpuBackend {
     /// Plans `scene` (with the traversal counters where asked) and makes
     /// sure its pipeline is compiled.
     fn compile(&mut self, scene: &RenderScene) -> Result<Plan, GpuError> {
-        let plan = Plan::with_bvh(scene, self.bvh)?.for_kernel(self.kernel, self.stats);
+        let plan = Plan::with_levels(scene, self.bvh, &mut self.levels)?
+            .for_kernel(self.kernel, self.stats);
         let s = &scene.settings;
         let max_depth = if s.max_depth < 0 {
             UNLIMITED_DEPTH_CAP

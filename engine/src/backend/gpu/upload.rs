@@ -127,6 +127,49 @@ fn motion_record(m: &Motion) -> [Vec4; 12] {
     [o0, o1, o2, i0, i1, i2, a0, a1, a2, b0, b1, b2]
 }
 
+/// Bottom levels as the last frame laid them out, so that a frame lays
+/// out only the levels that changed (deforming meshes) or moved in the
+/// arrays (those after a level whose size changed). Instances, the top
+/// level and the motion records are laid out every frame.
+#[derive(Debug, Default)]
+pub struct LevelCache {
+    /// Per bottom level of the accelerator.
+    levels: Vec<Option<CachedLevel>>,
+    /// Bottom levels laid out (not taken from the cache) so far.
+    built: u64,
+}
+
+impl LevelCache {
+    /// How many bottom levels were laid out rather than reused.
+    pub fn built(&self) -> u64 {
+        self.built
+    }
+}
+
+/// What a bottom level's layout depends on: the level's version and where
+/// its nodes and primitives start (references in them are absolute), and
+/// the layout's options.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct LevelKey {
+    version: u64,
+    nodes: usize,
+    prims: usize,
+    layout: BvhLayout,
+    motion: bool,
+    tangent_frames: bool,
+}
+
+/// One bottom level's rows, as laid out for `key`.
+#[derive(Debug)]
+struct CachedLevel {
+    key: LevelKey,
+    nodes: Vec<Vec4>,
+    prims: Vec<Vec4>,
+    shading: Vec<Vec4>,
+    spheres: bool,
+    root: u32,
+}
+
 impl Geometry {
     /// `vec4f` rows per primitive (`PRIM_ROWS` in `geometry.wgsl`).
     pub fn prim_rows(&self) -> usize {
@@ -146,6 +189,16 @@ impl Geometry {
 
     /// Lays out the geometry of `scene` with hierarchies of `layout`.
     pub fn new(scene: &RenderScene, layout: BvhLayout) -> Result<Self, GpuError> {
+        Self::with_cache(scene, layout, &mut LevelCache::default())
+    }
+
+    /// [`Geometry::new`], taking the bottom levels that did not change
+    /// from `cache` (and keeping this frame's there for the next).
+    pub fn with_cache(
+        scene: &RenderScene,
+        layout: BvhLayout,
+        cache: &mut LevelCache,
+    ) -> Result<Self, GpuError> {
         let accel = &scene.accel;
         let mut g = Geometry {
             layout,
@@ -156,8 +209,9 @@ impl Geometry {
         };
         let total: usize = accel.blases().iter().map(|b| b.len()).sum();
         g.shading = vec![[0.0; 4]; g.shading_rows() * total];
+        cache.levels.resize_with(accel.blases().len(), || None);
         let roots: Vec<u32> = (0..accel.blases().len())
-            .map(|b| g.bottom_level(scene, b))
+            .map(|b| g.cached_bottom_level(scene, b, cache))
             .collect();
         let instances = accel.instances();
         let direct = instances.len() == 1 && instances[0].place == Place::Identity;
@@ -171,6 +225,49 @@ impl Geometry {
             g.instances.extend(motion_record(m));
         }
         Ok(g)
+    }
+
+    /// Bottom level `b` from `cache` where it is the same level at the same
+    /// place in the arrays as last frame, else laid out and kept there.
+    /// Returns its root.
+    fn cached_bottom_level(
+        &mut self,
+        scene: &RenderScene,
+        b: usize,
+        cache: &mut LevelCache,
+    ) -> u32 {
+        let blas = &scene.accel.blases()[b];
+        let key = LevelKey {
+            version: blas.version(),
+            nodes: self.nodes.len(),
+            prims: self.prims.len(),
+            layout: self.layout,
+            motion: self.motion,
+            tangent_frames: self.tangent_frames,
+        };
+        let rows = self.shading_rows();
+        let shading =
+            rows * scene.accel.base(b) as usize..rows * (scene.accel.base(b) as usize + blas.len());
+        if let Some(level) = cache.levels[b].as_ref().filter(|l| l.key == key) {
+            self.nodes.extend_from_slice(&level.nodes);
+            self.prims.extend_from_slice(&level.prims);
+            self.shading[shading].copy_from_slice(&level.shading);
+            self.spheres |= level.spheres;
+            return level.root;
+        }
+        let spheres = std::mem::take(&mut self.spheres);
+        let root = self.bottom_level(scene, b);
+        cache.built += 1;
+        cache.levels[b] = Some(CachedLevel {
+            nodes: self.nodes[key.nodes..].to_vec(),
+            prims: self.prims[key.prims..].to_vec(),
+            shading: self.shading[shading].to_vec(),
+            spheres: self.spheres,
+            root,
+            key,
+        });
+        self.spheres |= spheres;
+        root
     }
 
     /// Lays out bottom level `b` of the scene's accelerator: its nodes,
