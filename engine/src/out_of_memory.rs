@@ -3,8 +3,8 @@
 //! — one that no estimate foresaw, after the checks made before a film, a
 //! mesh, a BVH or a texture is taken — the process says so on stderr and
 //! exits with status 1, as for any other error, instead of aborting
-//! (status 134). It allocates nothing itself: the message is formatted on
-//! the stack.
+//! (status 134), removing the temporary files of outputs not yet complete.
+//! It allocates nothing itself: the message is formatted on the stack.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::io::Write;
@@ -52,5 +52,7 @@ fn checked(ptr: *mut u8, size: usize) -> *mut u8 {
     );
     let len = 320 - out.len();
     let _ = std::io::stderr().write_all(&message[..len]);
+    // No half-written output is left behind.
+    radiant::film::output::remove_unfinished_outputs();
     std::process::exit(1)
 }

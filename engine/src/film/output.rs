@@ -63,7 +63,28 @@ pub fn temp_file_beside(path: &Path, suffix: &str) -> std::io::Result<tempfile::
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    builder.tempfile_in(dir)
+    let file = builder.tempfile_in(dir)?;
+    // Remembered for `remove_unfinished_outputs`; a completed file is
+    // renamed away, so its entry names nothing by then.
+    if let Ok(mut pending) = UNFINISHED.lock() {
+        pending.push(file.path().to_path_buf());
+    }
+    Ok(file)
+}
+
+/// The temporary files made by [`temp_file_beside`] in this process.
+static UNFINISHED: std::sync::Mutex<Vec<std::path::PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Removes the temporary files of outputs not yet complete, for an exit
+/// that skips their destructors (the out-of-memory exit of the binary's
+/// allocator). It allocates nothing (a path up to a few hundred bytes is
+/// converted on the stack) and gives up rather than wait for the list.
+pub fn remove_unfinished_outputs() {
+    if let Ok(pending) = UNFINISHED.try_lock() {
+        for path in pending.iter() {
+            let _ = std::fs::remove_file(path);
+        }
+    }
 }
 
 /// Writes `image` to `path`, choosing the format by extension.
