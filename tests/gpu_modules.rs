@@ -17,6 +17,7 @@ use radiant_core::{
     CameraRays, Effects, EmitterEval, EmitterHit, GpuModule, LightSample, Rgb, TextureId,
     TextureRef,
 };
+use radiant_tests::SplitMix as Rng;
 use std::ops::Range;
 
 /// Records per comparison.
@@ -25,24 +26,19 @@ const RECORDS: usize = 4096;
 /// Share of records allowed to disagree.
 const ALLOWED: f64 = 0.005;
 
-/// Deterministic random numbers (SplitMix64).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
-
+/// The inputs the module probes draw, from the tests' SplitMix64.
+trait Inputs {
     /// Uniform in [a, b).
+    fn range(&mut self, a: f32, b: f32) -> f32;
+    /// Each coordinate uniform in [a, b).
+    fn vec3(&mut self, a: f32, b: f32) -> Vec3;
+    /// A uniform unit vector.
+    fn direction(&mut self) -> Vec3;
+    /// A sample in [0, 1)², now and then at its edges.
+    fn sample2(&mut self) -> Vec2;
+}
+
+impl Inputs for Rng {
     fn range(&mut self, a: f32, b: f32) -> f32 {
         a + (b - a) * self.unit()
     }
@@ -51,14 +47,12 @@ impl Rng {
         Vec3::new(self.range(a, b), self.range(a, b), self.range(a, b))
     }
 
-    /// A uniform unit vector.
     fn direction(&mut self) -> Vec3 {
         radiant_core::warp::square_to_uniform_sphere(Vec2::new(self.unit(), self.unit()))
     }
 
-    /// A sample in [0, 1)², now and then at its edges.
     fn sample2(&mut self) -> Vec2 {
-        let mut c = || match self.next() % 64 {
+        let mut c = || match self.bits() % 64 {
             0 => 0.0,
             1 => 0.999_999_94,
             _ => self.unit(),
@@ -315,7 +309,7 @@ fn check_lights(label: &str, scene: &RenderScene, reach: f32, seed: u64) -> Vec<
                     origin: rng.vec3(-reach, reach),
                     p: rng.vec3(-reach, reach),
                     n: rng.direction(),
-                    primitive: (rng.next() % 24) as u32,
+                    primitive: (rng.bits() % 24) as u32,
                 })
                 .collect();
             let mut out = vec![EmitterEval::default(); RECORDS];
@@ -456,12 +450,12 @@ fn environment_lights() {
         if y == 2 || y == 3 || x == 4 {
             [0, 0, 0, 0]
         } else {
-            let m = |rng: &mut Rng| 128 + (rng.next() % 128) as u8;
+            let m = |rng: &mut Rng| 128 + (rng.bits() % 128) as u8;
             [
                 m(&mut rng),
                 m(&mut rng),
                 m(&mut rng),
-                126 + (rng.next() % 6) as u8,
+                126 + (rng.bits() % 6) as u8,
             ]
         }
     });
@@ -614,11 +608,11 @@ const TEXTURE: &[Field] = &[("c", 3)];
 fn texture_coordinates(rng: &mut Rng, n: usize) -> Vec<Vec2> {
     (0..n)
         .map(|_| {
-            let mut c = || match rng.next() % 50 {
+            let mut c = || match rng.bits() % 50 {
                 0 => rng.range(-1e7, 1e7),
                 1 => rng.range(-1e12, 1e12),
                 2 => rng.range(-1e14, 1e14),
-                3 => (rng.next() % 41) as f32 * 0.125 - 2.0,
+                3 => (rng.bits() % 41) as f32 * 0.125 - 2.0,
                 _ => rng.range(-2.0, 3.0),
             };
             Vec2::new(c(), c())
@@ -630,8 +624,8 @@ fn texture_coordinates(rng: &mut Rng, n: usize) -> Vec<Vec2> {
 fn float_image() -> Vec<u8> {
     let mut rng = Rng(7);
     hdr(13, 11, |_, _| {
-        let mut m = || 128 + (rng.next() % 128) as u8;
-        [m(), m(), m(), 120 + (rng.next() % 12) as u8]
+        let mut m = || 128 + (rng.bits() % 128) as u8;
+        [m(), m(), m(), 120 + (rng.bits() % 12) as u8]
     })
 }
 

@@ -14,27 +14,11 @@ use radiant::backend::cpu::{Progress, render};
 use radiant::backend::gpu::probe::{Probe, ProbeKind};
 use radiant::extract::{Overrides, RenderScene, extract};
 use radiant_core::SampleId;
+use radiant_tests::SplitMix as Rng;
 use std::path::Path;
 
 /// Records per comparison.
 const RECORDS: usize = 4096;
-
-/// Deterministic random numbers (SplitMix64).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    fn below(&mut self, n: u32) -> u32 {
-        (self.next() % n as u64) as u32
-    }
-}
 
 /// The Cornell box with its sampler replaced by `sampler` (inline YAML),
 /// extracted with `overrides`.

@@ -21,6 +21,7 @@ use glam::{Vec2, Vec3};
 use radiant::backend::gpu::probe::{Probe, ProbeKind};
 use radiant::extract::{Overrides, RenderScene, extract};
 use radiant_core::{BsdfEval, BsdfSample, GpuModule, ShadeContext, SurfaceBatch};
+use radiant_tests::SplitMix as Rng;
 use radiant_tests::gpu::backend;
 use std::fmt::Write;
 use std::path::Path;
@@ -73,32 +74,6 @@ struct Record {
     wi: Vec3,
     dp_du: Vec3,
     dp_dv: Vec3,
-}
-
-/// SplitMix64: a small deterministic generator for the inputs.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    fn float(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    /// Uniform on the unit sphere.
-    fn sphere(&mut self) -> Vec3 {
-        let z = 1.0 - 2.0 * self.float();
-        let r = (1.0 - z * z).max(0.0).sqrt();
-        let phi = 2.0 * std::f32::consts::PI * self.float();
-        Vec3::new(r * phi.cos(), r * phi.sin(), z)
-    }
 }
 
 /// The scene holding `materials` as `m0`, `m1`, …, extracted, with the
@@ -243,11 +218,11 @@ fn records(scene: &RenderScene, m: usize, seed: u64) -> Vec<Record> {
     let mut recs: Vec<Record> = (0..RECORDS)
         .map(|_| Record {
             wo: rng.sphere(),
-            uv: Vec2::new(rng.float(), rng.float()),
-            u: Vec3::new(rng.float(), rng.float(), rng.float()),
+            uv: Vec2::new(rng.unit(), rng.unit()),
+            u: Vec3::new(rng.unit(), rng.unit(), rng.unit()),
             wi: rng.sphere(),
-            dp_du: rng.sphere() * (0.1 + 1.9 * rng.float()),
-            dp_dv: rng.sphere() * (0.1 + 1.9 * rng.float()),
+            dp_du: rng.sphere() * (0.1 + 1.9 * rng.unit()),
+            dp_dv: rng.sphere() * (0.1 + 1.9 * rng.unit()),
         })
         .collect();
     let specials = [

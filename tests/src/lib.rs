@@ -208,6 +208,40 @@ pub fn write_grid(path: &std::path::Path, n: usize, phase: f32, drop_face: bool)
     std::fs::write(path, text).expect("temporary files are writable");
 }
 
+/// SplitMix64: a small deterministic generator of test inputs (the GPU
+/// tests' random records).
+#[derive(Debug, Clone)]
+pub struct SplitMix(pub u64);
+
+impl SplitMix {
+    /// The next 64 random bits.
+    pub fn bits(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1).
+    pub fn unit(&mut self) -> f32 {
+        (self.bits() >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    /// Uniform in 0..n (n ≥ 1).
+    pub fn below(&mut self, n: u32) -> u32 {
+        (self.bits() % n as u64) as u32
+    }
+
+    /// Uniform on the unit sphere (z, then the azimuth).
+    pub fn sphere(&mut self) -> glam::Vec3 {
+        let z = 1.0 - 2.0 * self.unit();
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let phi = 2.0 * std::f32::consts::PI * self.unit();
+        glam::Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    }
+}
+
 pub mod chi2;
 pub mod gpu;
 pub mod shading;
