@@ -6,6 +6,7 @@
 //! read the settings of the frame. [`RenderSettings::with`] is the one place
 //! where [`Overrides`] are checked and applied.
 
+pub use crate::film::encoding::{Encoding, OutputOverrides};
 use serde::Deserialize;
 use std::fmt;
 
@@ -34,6 +35,9 @@ pub struct RenderSettings {
     pub light_selection: LightSelection,
     /// How samples reach the pixels through the pixel filter.
     pub filter_sampling: FilterSampling,
+    /// How the image's values are written (`film: {tonemap, bit_depth,
+    /// exr, jpeg_quality}`).
+    pub output: Encoding,
 }
 
 impl Default for RenderSettings {
@@ -49,6 +53,7 @@ impl Default for RenderSettings {
             seed: 0,
             light_selection: LightSelection::default(),
             filter_sampling: FilterSampling::default(),
+            output: Encoding::default(),
         }
     }
 }
@@ -132,6 +137,8 @@ pub struct Overrides {
     /// BVH build quality (default: [`BuildQuality::default_for`] each
     /// hierarchy's primitive count).
     pub bvh: Option<BuildQuality>,
+    /// Tone map, PNG bit depth and EXR sample type.
+    pub output: OutputOverrides,
 }
 
 /// An override outside the range a scene file allows.
@@ -171,6 +178,10 @@ impl RenderSettings {
         self.height = o.height.unwrap_or(self.height);
         self.light_selection = o.light_selection.unwrap_or(self.light_selection);
         self.filter_sampling = o.filter_sampling.unwrap_or(self.filter_sampling);
+        self.output = self
+            .output
+            .with(&o.output)
+            .map_err(|e| OverrideError(format!("the exposure override: {e}")))?;
         Ok(self)
     }
 

@@ -110,7 +110,7 @@ fn bad_arguments_are_refused_before_rendering() {
         out.to_str().unwrap(),
     ]);
     assert!(!o.status.success());
-    assert!(stderr(&o).contains(".png or .exr"), "{}", stderr(&o));
+    assert!(stderr(&o).contains(".exr or .hdr"), "{}", stderr(&o));
     assert!(!out.exists());
 
     let o = radiant(&[

@@ -170,7 +170,7 @@ fn bad_merges_name_the_files_and_write_nothing() {
     // An output that cannot be written is refused before any reading.
     let o = merge(&parts, &dir.path().join("merged.bmp"));
     assert!(
-        stderr(&o).contains("must end in .png or .exr"),
+        stderr(&o).contains("must end in .png, .jpg, .jpeg, .exr or .hdr"),
         "{}",
         stderr(&o)
     );

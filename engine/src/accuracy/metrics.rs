@@ -67,12 +67,22 @@ fn flip_image(image: &Image) -> nv_flip::FlipImageRgb8 {
 
 /// Mean LDR-FLIP error of `image` against `reference` (same size).
 pub fn flip(image: &Image, reference: &Image) -> f64 {
-    let error = nv_flip::flip(
+    mean_flip(&flip_map(image, reference))
+}
+
+/// Per-pixel LDR-FLIP error of `image` against `reference` (same size),
+/// both shown as clamped 8-bit sRGB.
+pub fn flip_map(image: &Image, reference: &Image) -> nv_flip::FlipImageFloat {
+    nv_flip::flip(
         flip_image(reference),
         flip_image(image),
         nv_flip::DEFAULT_PIXELS_PER_DEGREE,
-    );
-    nv_flip::FlipPool::from_image(&error).mean() as f64
+    )
+}
+
+/// The mean of a FLIP error map.
+pub fn mean_flip(map: &nv_flip::FlipImageFloat) -> f64 {
+    nv_flip::FlipPool::from_image(map).mean() as f64
 }
 
 /// Two independent renders of the same setting with the same samples per

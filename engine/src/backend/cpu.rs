@@ -11,7 +11,7 @@ use super::RenderError;
 pub use super::{Progress, Rendered, Written};
 use crate::extract::RenderScene;
 use crate::film::band::Bands;
-use crate::film::encode::{RowSink, write_with};
+use crate::film::encode::{RowSink, write_encoded};
 use crate::film::memory::FrameTooLarge;
 use crate::film::{Film, Reconstruction, TileFilm};
 use crate::integrators::path::{Batch, Wavefront};
@@ -66,7 +66,7 @@ pub fn write(
 ) -> Result<Written, RenderError> {
     let s = &scene.settings;
     let group = band_tile_rows(scene);
-    write_with(path, s.width, s.height, |rows| {
+    write_encoded(path, &s.output, s.width, s.height, |rows| {
         render_rows(scene, rows, group, progress)
     })
 }
@@ -277,6 +277,7 @@ mod tests {
     use super::*;
     use crate::extract::{Overrides, extract};
     use crate::film::Image;
+    use crate::film::encode::write_with;
     use std::path::Path;
 
     /// The Cornell box at `width`×`height` pixels and `spp`.

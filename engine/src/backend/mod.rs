@@ -148,7 +148,7 @@ pub trait Backend: Send {
                 error,
             })?;
         let rendered = self.render(scene, progress)?;
-        crate::film::output::write(path, &rendered.image)?;
+        crate::film::output::write_encoded(path, &rendered.image, &s.output)?;
         Ok(Written::from(&rendered))
     }
 

@@ -1,18 +1,19 @@
 //! Command-line parsing (clap) and the subcommands.
 
 mod accuracy;
+mod compare;
 mod diagnostic;
 mod farm;
 mod film_args;
 mod info;
 mod merge;
 mod modules;
+mod output_args;
 mod render;
 mod sampling_args;
 mod sheet;
 
 use clap::{Parser, Subcommand};
-use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Radiant: a physically based path-tracing scene engine.
@@ -40,13 +41,9 @@ enum Command {
     /// Render on a cluster: Slurm job scripts, and the state of a sequence.
     #[command(subcommand)]
     Farm(farm::FarmCommand),
-    /// Compare an image against a reference (RMSE, relative MSE, mean ratio).
-    Compare {
-        /// The image to judge (EXR).
-        image: PathBuf,
-        /// The reference (EXR).
-        reference: PathBuf,
-    },
+    /// Compare an image against a reference (RMSE, relative MSE, mean ratio,
+    /// FLIP) in any format Radiant writes; `--diff` writes a FLIP heat map.
+    Compare(compare::CompareArgs),
 }
 
 /// Parses the command line and runs the command; errors print as
@@ -60,7 +57,7 @@ pub fn run() -> ExitCode {
     .ok();
     let registry = radiant::builtin_registry();
     let result = match cli.command {
-        Command::Render(args) => render::run(&registry, &args),
+        Command::Render(args) => render::run(&registry, &args.with_default_output()),
         Command::Accuracy(args) => accuracy::run(&registry, &args),
         Command::Info(args) => info::run(&registry, &args),
         Command::Sheet(args) => sheet::run(&args),
@@ -70,7 +67,7 @@ pub fn run() -> ExitCode {
             modules::run(&registry);
             Ok(())
         }
-        Command::Compare { image, reference } => compare(&image, &reference),
+        Command::Compare(args) => compare::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -79,39 +76,4 @@ pub fn run() -> ExitCode {
             ExitCode::FAILURE
         }
     }
-}
-
-fn compare(image: &std::path::Path, reference: &std::path::Path) -> miette::Result<()> {
-    use radiant::film::output::read_exr;
-    let read = |path: &std::path::Path| {
-        let img = read_exr(path).map_err(|e| miette::miette!("{e}"))?;
-        let bad = img.pixels.iter().filter(|p| !p.is_finite()).count();
-        if bad > 0 {
-            miette::bail!(
-                "`{}`: {bad} pixels are NaN or infinite; compare needs finite images",
-                path.display()
-            );
-        }
-        Ok(img)
-    };
-    let (a, b) = (read(image)?, read(reference)?);
-    let c = radiant::compare::compare(&a, &b).ok_or_else(|| {
-        miette::miette!(
-            "the images differ in size: `{}` is {}x{} and `{}` is {}x{}",
-            image.display(),
-            a.width,
-            a.height,
-            reference.display(),
-            b.width,
-            b.height
-        )
-    })?;
-    println!("rmse {:.6}", c.rmse);
-    println!("relative_mse {:.6}", c.relative_mse);
-    if c.mean_ratio.is_finite() {
-        println!("mean_ratio {:.6}", c.mean_ratio);
-    } else {
-        println!("mean_ratio undefined (the reference's mean is 0)");
-    }
-    Ok(())
 }

@@ -5,12 +5,13 @@ mod partition;
 
 use super::diagnostic::report;
 use super::film_args::FilmArgs;
+use super::output_args::OutputArgs;
 use super::sampling_args::SamplingArgs;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use radiant::Registry;
 use radiant::backend::{Backend, BackendKind, Progress, choose};
-use radiant::extract::{Sequence, SequenceOptions};
+use radiant::extract::{Overrides, Sequence, SequenceOptions};
 use radiant::world::Timeline;
 use radiant::world::systems::substitute_frame;
 use std::path::{Path, PathBuf};
@@ -21,10 +22,17 @@ use std::time::{Duration, Instant};
 pub struct RenderArgs {
     /// The scene file (YAML).
     scene: PathBuf,
-    /// Output image: .png (tone-mapped sRGB) or .exr (linear float RGB). A
-    /// run of `#` in the name becomes the frame number, zero-padded to the
-    /// run's length (`out/frame_####.png`).
-    #[arg(short, long)]
+    /// Output image: .png (tone-mapped sRGB, 8 or 16 bit), .jpg/.jpeg
+    /// (tone-mapped sRGB), .exr (linear float or half RGB) or .hdr (linear
+    /// Radiance RGBE). A run of `#` in the name becomes the frame number,
+    /// zero-padded to the run's length (`out/frame_####.png`). Default: the
+    /// scene file's name with .png in the current folder (`NAME_####.png`
+    /// for a range of frames).
+    #[arg(short = 'o', long = "output", value_name = "OUTPUT")]
+    output_arg: Option<PathBuf>,
+    /// The output: `--output`, or the default (see
+    /// [`RenderArgs::with_default_output`]).
+    #[arg(skip)]
     output: PathBuf,
     /// The frames to render: `A..B` (inclusive) or one frame `N` (default:
     /// the scene's first frame).
@@ -41,6 +49,8 @@ pub struct RenderArgs {
     lock_noise: bool,
     #[command(flatten)]
     sampling: SamplingArgs,
+    #[command(flatten)]
+    encoding: OutputArgs,
     /// Which backend renders: `gpu` (fails where there is no adapter or a
     /// module lacks GPU code), `cpu`, or `auto` (the GPU where a hardware
     /// adapter can render the scene, else the CPU; says which on stderr).
@@ -69,6 +79,30 @@ pub struct RenderArgs {
     film: FilmArgs,
 }
 
+impl RenderArgs {
+    /// These arguments with the default output name where none was given:
+    /// the scene file's stem with `.png`, in the current folder, and a
+    /// frame-number pattern where `--frames` names several frames.
+    pub fn with_default_output(mut self) -> Self {
+        if let Some(output) = self.output_arg.take() {
+            self.output = output;
+        } else {
+            let stem = self
+                .scene
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "render".into());
+            let several = self.frames.is_some_and(|(a, b)| b > a);
+            self.output = PathBuf::from(if several {
+                format!("{stem}_####.png")
+            } else {
+                format!("{stem}.png")
+            });
+        }
+        self
+    }
+}
+
 /// Parses `A..B` or `N`.
 pub fn parse_frames(text: &str) -> Result<(i64, i64), String> {
     let number = |s: &str| {
@@ -91,17 +125,14 @@ pub fn parse_frames(text: &str) -> Result<(i64, i64), String> {
     Ok((a, b))
 }
 
-/// Checks that `output` can be written: a .png or .exr name in a folder
-/// that exists.
+/// Checks that `output` can be written: a name whose extension is a format
+/// Radiant writes, in a folder that exists.
 pub(super) fn check_output(output: &Path) -> miette::Result<()> {
-    let ext = output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    if !matches!(ext.as_deref(), Some("png" | "exr")) {
+    if radiant::film::encode::Format::of(output).is_err() {
         miette::bail!(
-            "cannot write `{}`: the output name must end in .png or .exr",
-            output.display()
+            "cannot write `{}`: the output name must end in {}",
+            output.display(),
+            radiant::film::encode::Format::EXTENSIONS
         );
     }
     if output.is_dir() {
@@ -181,7 +212,10 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
             args.output.display()
         );
     }
-    let overrides = args.sampling.overrides(&args.film);
+    let overrides = Overrides {
+        output: args.encoding.overrides(),
+        ..args.sampling.overrides(&args.film)
+    };
     let options = SequenceOptions {
         lock_noise: args.lock_noise,
         ..SequenceOptions::default()

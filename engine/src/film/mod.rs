@@ -11,9 +11,12 @@
 
 pub mod band;
 pub mod encode;
+pub mod encoding;
 pub mod memory;
 pub mod output;
+pub mod rgbe;
 pub mod sheet;
+pub mod tonemap;
 
 use crate::settings::FilterSampling;
 use glam::{Vec2, Vec4};

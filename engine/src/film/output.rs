@@ -1,8 +1,10 @@
-//! Image files: PNG (tone-mapped sRGB, 8 bit) and EXR (linear float RGB),
+//! Image files: PNG (tone-mapped sRGB, 8 or 16 bit), JPEG (tone-mapped
+//! sRGB), EXR (linear float or half RGB) and Radiance HDR (linear RGBE),
 //! written atomically: into a temporary file beside the target, then
 //! renamed over it, so an interrupted write never leaves a broken file.
 //! A whole [`Image`] is written here through the row encoders of
-//! [`super::encode`], which banded renders feed row by row.
+//! [`super::encode`], which banded renders feed row by row; [`read`]
+//! reads any of them back as linear values (PNG and JPEG sRGB-decoded).
 
 use super::Image;
 use super::encode;
@@ -12,7 +14,7 @@ use std::path::Path;
 #[derive(Debug, thiserror::Error)]
 pub enum ImageError {
     /// The extension names no supported format.
-    #[error("cannot write `{0}`: the file name must end in .png or .exr")]
+    #[error("cannot write `{0}`: the file name must end in .png, .jpg, .jpeg, .exr or .hdr")]
     UnknownFormat(String),
     /// Reading or writing failed.
     #[error("{path}: {message}")]
@@ -87,10 +89,66 @@ pub fn remove_unfinished_outputs() {
     }
 }
 
-/// Writes `image` to `path`, choosing the format by extension.
+/// Writes `image` to `path`, choosing the format by extension, with the
+/// default encoding (clamped 8-bit sRGB, float EXR).
 pub fn write(path: impl AsRef<Path>, image: &Image) -> Result<(), ImageError> {
-    encode::write_with(path.as_ref(), image.width, image.height, |rows| {
+    write_encoded(path, image, &super::encoding::Encoding::default())
+}
+
+/// Writes `image` to `path`, choosing the format by extension, its values
+/// as `encoding` says.
+pub fn write_encoded(
+    path: impl AsRef<Path>,
+    image: &Image,
+    encoding: &super::encoding::Encoding,
+) -> Result<(), ImageError> {
+    encode::write_encoded(path.as_ref(), encoding, image.width, image.height, |rows| {
         rows.write_rows(&image.pixels)
+    })
+}
+
+/// The first bytes of every OpenEXR file.
+const EXR_MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
+
+/// Reads an image Radiant writes, whatever its extension says — EXR,
+/// Radiance HDR, PNG (8 or 16 bit), JPEG — as linear RGB: EXR and HDR as
+/// stored, PNG and JPEG sRGB-decoded (their tone curve, if any, is not
+/// undone; alpha is dropped).
+pub fn read(path: impl AsRef<Path>) -> Result<Image, ImageError> {
+    use std::io::Read;
+    let path = path.as_ref();
+    let mut magic = [0u8; 4];
+    let is_exr = std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut magic))
+        .is_ok_and(|()| magic == EXR_MAGIC);
+    if is_exr {
+        return read_exr(path);
+    }
+    let reader = image::ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
+        .map_err(|e| io_error(path, e))?;
+    let linear = reader.format() == Some(image::ImageFormat::Hdr);
+    let decoded = reader.decode().map_err(|e| {
+        io_error(
+            path,
+            format!("{e} (Radiant reads EXR, Radiance HDR, PNG and JPEG images)"),
+        )
+    })?;
+    let rgb = decoded.to_rgb32f();
+    let decode = |c: f32| {
+        if linear {
+            c
+        } else {
+            radiant_textures::srgb_to_linear(c)
+        }
+    };
+    Ok(Image {
+        width: rgb.width(),
+        height: rgb.height(),
+        pixels: rgb
+            .pixels()
+            .map(|p| radiant_core::Rgb::from(p.0.map(decode)))
+            .collect(),
     })
 }
 

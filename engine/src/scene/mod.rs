@@ -181,6 +181,7 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
             seed: 0,
             light_selection,
             filter_sampling: film.filter_sampling,
+            output: film.encoding,
         },
         timeline,
         frame: timeline.start,
@@ -560,6 +561,65 @@ struct FilmParams {
     height: u32,
     #[serde(default)]
     filter_sampling: FilterSampling,
+    #[serde(default)]
+    tonemap: TonemapKeys,
+    #[serde(default)]
+    bit_depth: crate::film::encoding::BitDepth,
+    #[serde(default)]
+    exr: crate::film::encoding::ExrSamples,
+    #[serde(default = "default_jpeg_quality")]
+    jpeg_quality: u8,
+    /// The keys above as the encoder takes them (checked after parsing).
+    #[serde(skip)]
+    encoding: crate::film::encoding::Encoding,
+}
+
+/// `film: {tonemap: {type: clamp | reinhard | aces | agx, exposure: EV}}`.
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct TonemapKeys {
+    #[serde(rename = "type", default)]
+    curve: crate::film::tonemap::Curve,
+    #[serde(default)]
+    exposure: f32,
+}
+
+fn default_jpeg_quality() -> u8 {
+    crate::film::encoding::DEFAULT_JPEG_QUALITY
+}
+
+/// The film's output encoding from its keys; `node` is the film mapping,
+/// for the location of a bad value.
+fn film_encoding(
+    file: &Path,
+    node: &marked_yaml::Node,
+    p: &FilmParams,
+) -> Result<crate::film::encoding::Encoding, SceneError> {
+    let at = |keys: &[&str]| {
+        let mut n = Some(node);
+        for key in keys {
+            n = n.and_then(|n| n.as_mapping()).and_then(|m| m.get_node(key));
+        }
+        loc(n.unwrap_or(node).span())
+    };
+    let tonemap = crate::film::tonemap::Tonemap::new(p.tonemap.curve, p.tonemap.exposure)
+        .map_err(|e| SceneError::new(file, at(&["tonemap", "exposure"]), e.to_string()))?;
+    if !(1..=100).contains(&p.jpeg_quality) {
+        return Err(SceneError::new(
+            file,
+            at(&["jpeg_quality"]),
+            format!(
+                "film jpeg_quality must be between 1 and 100, found {}",
+                p.jpeg_quality
+            ),
+        ));
+    }
+    Ok(crate::film::encoding::Encoding {
+        tonemap,
+        bit_depth: p.bit_depth,
+        exr: p.exr,
+        jpeg_quality: p.jpeg_quality,
+    })
 }
 
 fn default_width() -> u32 {
@@ -591,6 +651,11 @@ fn parse_film(
                 width: default_width(),
                 height: default_height(),
                 filter_sampling: FilterSampling::default(),
+                tonemap: TonemapKeys::default(),
+                bit_depth: Default::default(),
+                exr: Default::default(),
+                jpeg_quality: default_jpeg_quality(),
+                encoding: Default::default(),
             },
             default_module("gaussian"),
         ));
@@ -604,14 +669,27 @@ fn parse_film(
     let height = map.get("height");
     // Parsed with the other plain keys below.
     map.get("filter_sampling");
-    map.finish(&["width", "height", "filter", "filter_sampling"])?;
+    for key in ["tonemap", "bit_depth", "exr", "jpeg_quality"] {
+        map.get(key);
+    }
+    map.finish(&[
+        "width",
+        "height",
+        "filter",
+        "filter_sampling",
+        "tonemap",
+        "bit_depth",
+        "exr",
+        "jpeg_quality",
+    ])?;
     let mut rest = marked_yaml::types::MarkedMappingNode::new_empty(*node.span());
     for (key, value) in node.as_mapping().into_iter().flat_map(|m| m.iter()) {
         if key.as_str() != "filter" {
             rest.insert(key.clone(), value.clone());
         }
     }
-    let p: FilmParams = parse_node(file, &marked_yaml::Node::Mapping(rest))?;
+    let mut p: FilmParams = parse_node(file, &marked_yaml::Node::Mapping(rest))?;
+    p.encoding = film_encoding(file, node, &p)?;
     for (value, key, n) in [(p.width, "width", width), (p.height, "height", height)] {
         if !(1..=MAX_FILM_SIZE).contains(&value) {
             return Err(SceneError::new(
