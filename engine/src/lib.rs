@@ -14,6 +14,11 @@
 //! 5. [`backend`] runs the integrator over tiles on all cores.
 //! 6. [`film`] accumulates filtered samples and writes PNG/EXR atomically.
 //!
+//! With the default `cli` feature, [`cli::run`] is the whole `radiant`
+//! command line for any registry, so a module crate's binary is
+//! `radiant::cli::run(registry)` (see `tests/outside-module/src/main.rs`),
+//! and [`accuracy`] is the accuracy tool behind `radiant accuracy`.
+//!
 //! ```no_run
 //! let registry = radiant::builtin_registry();
 //! let scene = radiant::scene::load("scenes/cornell-box.yaml").unwrap();
@@ -22,15 +27,23 @@
 //! radiant::film::output::write("cornell.exr", &image.image).unwrap();
 //! ```
 
+// The command line's modules name the library `radiant::…`, as they did
+// when they were the binary's own; this keeps those paths valid inside it.
+extern crate self as radiant;
+
 pub mod accel;
+#[cfg(feature = "cli")]
 pub mod accuracy;
 pub mod backend;
+#[cfg(feature = "cli")]
+pub mod cli;
 pub mod compare;
 pub mod error;
 pub mod extract;
 pub mod farm;
 pub mod film;
 pub mod integrators;
+pub mod out_of_memory;
 pub mod scene;
 pub mod settings;
 pub mod world;

@@ -5,6 +5,15 @@
 //! exits with status 1, as for any other error, instead of aborting
 //! (status 134), removing the temporary files of outputs not yet complete.
 //! It allocates nothing itself: the message is formatted on the stack.
+//!
+//! The `radiant` binary installs it, and so can any binary built on the
+//! library (a module crate's own `radiant`, for one):
+//!
+//! ```no_run,standalone_crate
+//! #[global_allocator]
+//! static ALLOCATOR: radiant::out_of_memory::ExitOnFailure = radiant::out_of_memory::ExitOnFailure;
+//! # fn main() {}
+//! ```
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::io::Write;
@@ -53,6 +62,6 @@ fn checked(ptr: *mut u8, size: usize) -> *mut u8 {
     let len = 320 - out.len();
     let _ = std::io::stderr().write_all(&message[..len]);
     // No half-written output is left behind.
-    radiant::film::output::remove_unfinished_outputs();
+    crate::film::output::remove_unfinished_outputs();
     std::process::exit(1)
 }

@@ -248,7 +248,8 @@ impl Backend for gpu::GpuBackend {
 }
 
 /// Which backend renders (`--backend`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum BackendKind {
     /// The CPU path tracer.
     Cpu,

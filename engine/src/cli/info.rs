@@ -161,6 +161,9 @@ pub fn run(registry: &Registry, args: &InfoArgs) -> miette::Result<()> {
     if repairs.missing_uvs {
         println!("uvs          missing in some meshes: (0,0), (1,0), (0,1) per triangle");
     }
+    for warning in radiant::extract::facing::back_facing(&r) {
+        eprintln!("warning: {warning}");
+    }
     println!(
         "bvh build    {:.3} ms",
         r.stats.bvh_build.as_secs_f64() * 1e3

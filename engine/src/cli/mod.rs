@@ -1,4 +1,19 @@
-//! Command-line parsing (clap) and the subcommands.
+//! The `radiant` command line as a library entry point: parsing (clap), the
+//! subcommands, the progress bar and the located diagnostics (miette), for
+//! any [`Registry`]. The `radiant` binary runs it with the built-in
+//! modules; a module crate's binary registers its own modules as well and
+//! gets every subcommand for them:
+//!
+//! ```no_run,standalone_crate
+//! #[global_allocator]
+//! static ALLOCATOR: radiant::cli::ExitOnFailure = radiant::cli::ExitOnFailure;
+//!
+//! fn main() -> std::process::ExitCode {
+//!     let mut registry = radiant::builtin_registry();
+//!     // my_modules::register(&mut registry);
+//!     radiant::cli::run(registry)
+//! }
+//! ```
 
 mod accuracy;
 mod compare;
@@ -13,7 +28,9 @@ mod render;
 mod sampling_args;
 mod sheet;
 
+pub use crate::out_of_memory::ExitOnFailure;
 use clap::{Parser, Subcommand};
+use radiant::Registry;
 use std::process::ExitCode;
 
 /// Radiant: a physically based path-tracing scene engine.
@@ -46,16 +63,15 @@ enum Command {
     Compare(compare::CompareArgs),
 }
 
-/// Parses the command line and runs the command; errors print as
-/// diagnostics and give a non-zero exit status.
-pub fn run() -> ExitCode {
+/// Parses the command line and runs the command with the modules of
+/// `registry`; errors print as diagnostics and give a non-zero exit status.
+pub fn run(registry: Registry) -> ExitCode {
     let cli = Cli::parse();
     // Keep each message on one line so `file:line:column` stays greppable.
     miette::set_hook(Box::new(|_| {
         Box::new(miette::MietteHandlerOpts::new().wrap_lines(false).build())
     }))
     .ok();
-    let registry = radiant::builtin_registry();
     let result = match cli.command {
         Command::Render(args) => render::run(&registry, &args.with_default_output()),
         Command::Accuracy(args) => accuracy::run(&registry, &args),

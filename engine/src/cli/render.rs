@@ -243,6 +243,9 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
                 for (shape, what) in &r.stats.repaired_shapes {
                     eprintln!("warning: {shape}: {}", what.describe());
                 }
+                for warning in radiant::extract::facing::back_facing(r) {
+                    eprintln!("warning: {warning}");
+                }
                 state = Some(s);
                 u
             }

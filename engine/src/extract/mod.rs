@@ -22,6 +22,7 @@
 //!
 //! [`extract`] builds the scene's current frame alone.
 
+pub mod facing;
 mod geometry;
 mod lights;
 mod materials;

@@ -722,20 +722,28 @@ fn parse_sampler(
     };
     let spec = ModuleSpec::from_node(file, node, "sampler", &["spp"])?;
     let mut keys = marked_yaml::types::MarkedMappingNode::new_empty(*node.span());
-    if let Some((k, v)) = node
+    let spp = node
         .as_mapping()
-        .and_then(|m| m.iter().find(|(k, _)| k.as_str() == "spp"))
-    {
+        .and_then(|m| m.iter().find(|(k, _)| k.as_str() == "spp"));
+    if let Some((k, v)) = spp {
+        // A count of samples: zero or a negative number is named as such,
+        // not left to the integer parser ("invalid digit found in string").
+        let value = v
+            .as_scalar()
+            .and_then(|s| s.as_str().trim().parse::<f64>().ok());
+        if value.is_some_and(|n| n < 1.0) {
+            return Err(SceneError::new(
+                file,
+                loc(v.span()),
+                format!(
+                    "spp must be a positive integer (samples per pixel, 1 or more), found {}",
+                    v.as_scalar().map_or("", |s| s.as_str())
+                ),
+            ));
+        }
         keys.insert(k.clone(), v.clone());
     }
     let p: SamplerKeys = parse_node(file, &marked_yaml::Node::Mapping(keys))?;
-    if p.spp == 0 {
-        return Err(SceneError::new(
-            file,
-            loc(node.span()),
-            "spp must be at least 1",
-        ));
-    }
     Ok((p.spp, spec))
 }
 

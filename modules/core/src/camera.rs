@@ -22,7 +22,10 @@ pub struct CameraRays<'a> {
 /// A camera module.
 pub trait Camera: Send + Sync {
     /// Generates one primary ray per film position `film[i]` using the lens
-    /// sample `lens[i]` in [0,1)².
+    /// sample `lens[i]` in [0,1)²: writes `out.origins[i]`,
+    /// `out.directions[i]` (unit length, pointing into the scene) and
+    /// `out.weights[i]` (0 for a position with no ray) for every `i`; the
+    /// slices are not cleared between batches.
     fn generate(&self, film: &[Vec2], lens: &[Vec2], out: CameraRays<'_>);
 
     /// The camera's GPU side (see [`crate::gpu`]), `None` where the type has

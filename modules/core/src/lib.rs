@@ -14,7 +14,9 @@
 //!   signature per kind and parameters packed as words;
 //! * the small shared maths every module uses: [`Frame`], sampling warps in
 //!   [`warp`], stateless hashing in [`hash`], piecewise-constant
-//!   distributions in [`distribution`].
+//!   distributions in [`distribution`];
+//! * the helpers every shader author needs, in [`shading`] (range-checked
+//!   texture inputs such as [`fraction`], [`reflection_sample`]).
 //!
 //! Data flow: the engine parses a scene, looks up each `type` in the
 //! [`Registry`], hands the module its [`Params`] and a [`BuildContext`], and
@@ -37,6 +39,7 @@ pub mod params;
 pub mod registry;
 pub mod sampler;
 pub mod shader;
+pub mod shading;
 pub mod texture;
 pub mod warp;
 
@@ -52,6 +55,7 @@ pub use params::{Color, Numbers, ParamError, Params, TextureInput};
 pub use registry::{ModuleInfo, ModuleKind, ParamDoc, Registry};
 pub use sampler::{SampleId, Sampler};
 pub use shader::{BsdfEval, BsdfSample, Pooled, Scratch, ShadeContext, Shader, SurfaceBatch};
+pub use shading::{fraction, reflection_sample};
 pub use texture::{Texture, TextureId, TextureRef, TextureTable};
 
 pub use glam;

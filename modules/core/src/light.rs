@@ -64,8 +64,12 @@ pub trait Light: Send + Sync {
     /// Whether the light's emission is a delta distribution (cannot be hit).
     fn is_delta(&self) -> bool;
 
-    /// Samples a point on the light for each reference point `refs[i]` with
-    /// the 2D sample `u[i]`.
+    /// Samples a point on the light for each reference point `refs[i]`
+    /// (render space) with the 2D sample `u[i]`, writing every `out[i]`
+    /// (`out` is not cleared between batches; a failed sample is
+    /// [`LightSample::default`], pdf 0). A surface light's `n` is its
+    /// emitting side's normal: it emits towards `refs[i]` where
+    /// `n · (refs[i] − p) > 0`.
     fn sample(&self, refs: &[Vec3], u: &[Vec2], out: &mut [LightSample]);
 
     /// Evaluates emission for rays that hit this light's surface. Lights

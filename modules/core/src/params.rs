@@ -60,6 +60,32 @@ impl ParamError {
     }
 }
 
+/// The text of the scalar that starts at `mark`, found by walking `node`.
+fn scalar_at<'a>(node: &'a Node, mark: &marked_yaml::Marker) -> Option<&'a str> {
+    match node {
+        Node::Scalar(s) => (s.span().start() == Some(mark)).then(|| s.as_str()),
+        Node::Mapping(m) => m.values().find_map(|v| scalar_at(v, mark)),
+        Node::Sequence(s) => s.iter().find_map(|v| scalar_at(v, mark)),
+    }
+}
+
+/// What an integer key needs, where the YAML value `text` (at `path`) is
+/// not one: a negative number for a count, a fraction, or not a number
+/// (`parse_error`, serde's own words, says which).
+fn integer_message(path: Option<&str>, text: Option<&str>, parse_error: &str) -> String {
+    let (Some(text), Ok(value)) = (text, text.unwrap_or_default().trim().parse::<f64>()) else {
+        return format!("expected an integer: {parse_error}");
+    };
+    let key = path.map_or(String::new(), |p| format!(" for `{p}`"));
+    if value < 0.0 {
+        format!("expected a non-negative integer{key}, found {text}")
+    } else if value.fract() != 0.0 {
+        format!("expected a whole number{key}, found {text}")
+    } else {
+        format!("{text} is too large{key}")
+    }
+}
+
 /// The parameters of one module instance: a YAML mapping without the keys
 /// the engine consumes itself (`type`, and e.g. a camera's pose).
 #[derive(Debug, Clone)]
@@ -91,7 +117,8 @@ impl Params {
                     format!("expected a number: {e}")
                 }
                 marked_yaml::Error::IntegerParseFailure(..) => {
-                    format!("expected an integer: {e}")
+                    let text = e.start_mark().and_then(|m| scalar_at(&self.node, &m));
+                    integer_message(e.path(), text, &e.to_string())
                 }
                 marked_yaml::Error::NotBoolean(..) => "expected `true` or `false`".to_string(),
                 _ => e.to_string(),

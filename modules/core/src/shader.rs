@@ -205,10 +205,38 @@ impl<'a> ShadeContext<'a> {
 }
 
 /// A shader module (a BSDF).
+///
+/// Conventions (those of Mitsuba 3 and pbrt):
+///
+/// * Directions are unit vectors in each point's *local shading frame*:
+///   +z is the shading normal on the surface's front (the side its
+///   geometric normal points to: the winding's side for triangles, the
+///   outside of spheres), x and y the tangents (see [`SurfaceBatch`]).
+/// * Both directions point *away* from the surface: `wo` towards where the
+///   path came from (the camera's side), `wi` towards the light or the
+///   next vertex.
+/// * So `cos θ = w.z`: positive on the front, negative behind. A
+///   reflection has `wo.z` and `wi.z` of the same sign, a transmission
+///   opposite signs. The engine does not turn the frame towards the
+///   viewer: a one-sided shader sees `wo.z ≤ 0` on a back face and answers
+///   black (as the built-in `diffuse` does; `radiant info` warns where the
+///   camera sees mostly such backs); a two-sided or transmissive one
+///   handles both signs.
+/// * Values include the cosine: [`eval`](Self::eval) gives f · |cos θi|
+///   (`wi.z.abs()`), [`sample`](Self::sample) the weight f · |cos θi| / pdf;
+///   densities are per unit solid angle.
+/// * Batches: `out[i]` answers point `i` of `surface`, for every `i`
+///   below `surface.len()`. Write every element — `out` is not cleared
+///   between batches — with [`BsdfSample::default`] or
+///   [`BsdfEval::default`] where there is nothing. Allocate nothing while
+///   shading: borrow buffers from the [`ShadeContext`].
+/// * Helpers the built-in shaders use are public in [`crate::shading`]:
+///   range-checked inputs ([`fraction`](crate::fraction)) and
+///   [`reflection_sample`](crate::reflection_sample).
 pub trait Shader: Send + Sync {
     /// Samples an incident direction for each surface point, using the
     /// samples `u[i]` (a 1D value in `x` for lobe selection, a 2D value in
-    /// `y`, `z`).
+    /// `y`, `z`); `out[i].wi` points away from the surface.
     fn sample(
         &self,
         ctx: &mut ShadeContext<'_>,

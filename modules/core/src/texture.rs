@@ -10,7 +10,9 @@ use std::sync::Arc;
 
 /// A texture module: evaluates colours for a batch of (u, v) coordinates.
 pub trait Texture: Send + Sync {
-    /// Writes the texture's value at `uv[i]` into `out[i]`.
+    /// Writes the texture's value at `uv[i]` into `out[i]`, for every `i`
+    /// (linear RGB; `uv` may lie outside [0, 1]², where a texture repeats
+    /// or clamps as it documents). `out` is not cleared between batches.
     fn eval(&self, uv: &[Vec2], out: &mut [Rgb]);
 
     /// The single value of a texture that does not vary, if it is one.

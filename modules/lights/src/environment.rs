@@ -448,6 +448,7 @@ pub(crate) fn register(registry: &mut Registry) {
             params: DOCS,
         },
         |params: &Params, ctx| {
+            crate::not_on_a_shape("environment", ctx)?;
             let p: EnvironmentParams = params.parse()?;
             if !(p.scale >= 0.0 && p.scale.is_finite()) {
                 return Err(ParamError {

@@ -47,6 +47,24 @@ fn register_light<L: Light + 'static>(
             summary,
             params,
         },
-        move |params: &Params, ctx| Ok(Box::new(build(params, ctx)?) as Box<dyn Light>),
+        move |params: &Params, ctx| {
+            not_on_a_shape(type_name, ctx)?;
+            Ok(Box::new(build(params, ctx)?) as Box<dyn Light>)
+        },
     );
+}
+
+/// The error for a light that exists apart from any surface (a point, a
+/// spot, a direction, the environment) written as a shape's `emitter`:
+/// said before its own parameters are checked, which would otherwise ask
+/// for a `position` the shape cannot give it.
+fn not_on_a_shape(type_name: &str, ctx: &BuildContext<'_>) -> Result<(), ParamError> {
+    match ctx.emitter_shape {
+        Some(_) => Err(ParamError::new(format!(
+            "a `{type_name}` light cannot be attached to a shape (it emits from no surface): \
+             a shape's `emitter` must be a light that emits from the shape's surface \
+             (the built-in one is `area`); put the `{type_name}` light under `lights:`"
+        ))),
+        None => Ok(()),
+    }
 }

@@ -7,41 +7,7 @@ use radiant_core::{BuildContext, Effects, ParamError, Rgb, TextureId, TextureInp
 use serde::Deserialize;
 use serde::de::{self, Deserializer};
 
-/// Resolves a texture-or-constant input; constants must lie in
-/// `[min, max]` in every channel.
-pub(crate) fn checked(
-    ctx: &mut BuildContext<'_>,
-    input: &Spanned<TextureInput>,
-    name: &str,
-    min: f32,
-    max: f32,
-) -> Result<TextureId, ParamError> {
-    if let TextureInput::Value(v) = &**input
-        && !(v.is_finite() && v.min_element() >= min && v.max_element() <= max)
-    {
-        return Err(ParamError::at(
-            input.span(),
-            format!("`{name}` must lie in [{min}, {max}], found {v}"),
-        ));
-    }
-    ctx.texture(input)
-}
-
-/// Resolves a texture-or-constant input whose constants must lie in
-/// [0, 1] (reflectances, weights, roughness).
-pub(crate) fn fraction(
-    ctx: &mut BuildContext<'_>,
-    input: &Spanned<TextureInput>,
-    name: &str,
-) -> Result<TextureId, ParamError> {
-    checked(ctx, input, name, 0.0, 1.0)
-}
-
-/// The effects of the textures `ids` (empty for constants).
-pub(crate) fn texture_effects(ctx: &BuildContext<'_>, ids: &[TextureId]) -> Effects {
-    ids.iter()
-        .fold(Effects::empty(), |e, &id| e | ctx.textures.effects(id))
-}
+pub(crate) use radiant_core::shading::{checked, fraction, texture_effects};
 
 /// [`Effects::TANGENT_FRAMES`] where the parameters along the shading
 /// frame's two tangents, `u` and `v`, may differ (an anisotropic lobe);

@@ -9,17 +9,7 @@ use crate::microfacet::{Ggx, reflect, refract};
 use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::{BsdfSample, Rgb};
 
-/// A non-delta reflection sample (no change of medium: η = 1).
-#[inline]
-pub(crate) fn reflection_sample(wi: Vec3, weight: Rgb, pdf: f32) -> BsdfSample {
-    BsdfSample {
-        wi,
-        weight,
-        pdf,
-        delta: false,
-        eta: 1.0,
-    }
-}
+pub(crate) use radiant_core::shading::reflection_sample;
 
 /// A delta reflection about the normal, wi = (−wo.x, −wo.y, wo.z), chosen
 /// with probability `pdf`.

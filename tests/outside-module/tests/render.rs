@@ -11,20 +11,8 @@ use radiant::core::{Effects, ModuleInfo, Params, Rgb, Texture};
 use radiant::extract::{Overrides, extract};
 use std::path::Path;
 
-const SCENE: &str = "
-film: {width: 32, height: 32, filter: {type: box}}
-sampler: {type: independent, spp: 16}
-integrator: {type: path, max_depth: 2}
-camera: {type: perspective, fov: 40, look_at: {origin: [0, 0, 3], target: [0, 0, 0]}}
-textures:
-  stripes: {type: stripes, a: [0.9, 0.9, 0.9], b: [0.05, 0.05, 0.05], count: 2}
-materials:
-  striped: {type: diffuse, reflectance: stripes}
-shapes:
-  - {type: rectangle, material: striped}
-lights:
-  - {type: point, position: [0, 0, 2], intensity: 4}
-";
+/// The scene the crate's binary renders too (`tests/cli.rs`).
+const SCENE: &str = include_str!("../striped.yaml");
 
 #[test]
 fn outside_texture_renders() {

@@ -30,7 +30,8 @@ type Node = [Vec4; 4];
 const MAX_LEAF: u32 = 4;
 
 /// The hierarchy layout of the GPU backend (`--gpu-bvh`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum BvhLayout {
     /// Binary BVH, two child boxes per 64-byte node, up to 4 primitives
     /// per leaf.

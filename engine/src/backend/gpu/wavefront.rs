@@ -28,7 +28,8 @@ use crate::backend::Progress;
 use wgpu::util::DeviceExt;
 
 /// Which kernel renders the paths on the GPU (`--gpu-kernel`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum GpuKernel {
     /// One invocation traces one whole path (`wgsl/path.wgsl`).
     #[default]
