@@ -25,6 +25,7 @@ use anyhow::{Context, Result, bail};
 use radiant::accel::UpdatePolicy;
 use radiant::backend::cpu::{Progress, render};
 use radiant::extract::{Overrides, Sequence, SequenceOptions};
+use radiant::scene::mesh::MeshOptions;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Duration;
@@ -44,7 +45,8 @@ type Mesh = (Vec<[f32; 3]>, Vec<[u32; 3]>);
 
 /// The mesh's positions and triangles.
 fn read_mesh(path: &Path) -> Result<Mesh> {
-    let mesh = radiant::scene::obj::load_obj(path, true).map_err(anyhow::Error::msg)?;
+    let mesh =
+        radiant::scene::mesh::load(path, MeshOptions::default()).map_err(anyhow::Error::msg)?;
     Ok((
         mesh.positions.iter().map(|p| p.to_array()).collect(),
         mesh.triangles,
@@ -265,7 +267,8 @@ fn deform(mesh: &Path, frames: u32) -> Result<()> {
     // One refit against one rebuild of the mesh's hierarchy.
     let prims = |f: u32| -> Result<Vec<radiant::accel::Primitive>> {
         let path = dir.path().join(format!("m_{f:04}.obj"));
-        let m = radiant::scene::obj::load_obj_frame(&path, true).map_err(anyhow::Error::msg)?;
+        let m = radiant::scene::mesh::load_frame(&path, MeshOptions::default())
+            .map_err(anyhow::Error::msg)?;
         Ok(m.triangles
             .iter()
             .map(|t| radiant::accel::Primitive::Triangle(t.map(|i| m.positions[i as usize])))

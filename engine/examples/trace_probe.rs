@@ -166,7 +166,8 @@ fn cornell(rng: &mut Lcg, obj: Option<&Path>) -> Result<()> {
 
 /// Rays from a sphere around the mesh at `path` towards its bounding box.
 fn mesh(path: &Path, rng: &mut Lcg) -> Result<()> {
-    let mesh = radiant::scene::obj::load_obj(path, true).map_err(anyhow::Error::msg)?;
+    let mesh = radiant::scene::mesh::load(path, radiant::scene::mesh::MeshOptions::default())
+        .map_err(anyhow::Error::msg)?;
     let prims: Vec<Primitive> = mesh
         .triangles
         .iter()

@@ -23,10 +23,14 @@
 //! Every error names the file, line and column, what was expected and what
 //! is allowed. Relative paths are resolved against the scene file's folder.
 
+mod gltf;
 mod instances;
 mod keyframes;
 pub mod line_limit;
+pub mod mesh;
+pub mod normals;
 pub mod obj;
+pub mod ply;
 pub mod tangents;
 pub mod transform;
 mod yaml;
@@ -64,7 +68,7 @@ const TOP_KEYS: &[&str] = &[
     "lights",
     "animation",
 ];
-const SHAPE_TYPES: &[&str] = &["rectangle", "cube", "sphere", "mesh"];
+const SHAPE_TYPES: &[&str] = &["rectangle", "cube", "sphere", "mesh", "gltf"];
 const INTEGRATORS: &[&str] = &["path"];
 
 /// Loads the scene file at `path`.
@@ -88,6 +92,8 @@ struct Loader<'f> {
     /// Deforming meshes whose first frame is read once the frame range is
     /// known: (entity, pattern, where `filename` was written).
     sequences: Vec<(hecs::Entity, PendingSequence)>,
+    /// Textures that glTF materials define, added to `textures:`.
+    textures: Vec<(String, ModuleSpec)>,
 }
 
 /// Parses scene text; `file` names it in errors and `dir` resolves
@@ -109,6 +115,7 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
         materials: named_modules(file, top.get("materials"), "material")?,
         material_ids: HashMap::new(),
         sequences: Vec::new(),
+        textures: Vec::new(),
     };
     loader.material_ids = loader
         .materials
@@ -152,6 +159,7 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
             loader.light(&mut world, node)?;
         }
     }
+    textures.append(&mut loader.textures);
     top.finish(TOP_KEYS)?;
     loader.keyframes.check_all_read(&doc)?;
 
@@ -273,6 +281,10 @@ impl Loader<'_> {
     /// Spawns the camera; returns the shutter.
     fn camera(&mut self, world: &mut World, node: &Node) -> Result<Option<(f64, f64)>, SceneError> {
         let file = self.file;
+        if type_is(node, "gltf") {
+            let camera = gltf::camera_yaml(file, self.dir, node)?;
+            return self.camera(world, &camera);
+        }
         let mut module = ModuleSpec::from_node(
             file,
             node,
@@ -409,6 +421,9 @@ impl Loader<'_> {
 
     /// Spawns shape `index` of `shapes:`.
     fn shape(&mut self, world: &mut World, node: &Node, index: usize) -> Result<(), SceneError> {
+        if type_is(node, "gltf") {
+            return self.gltf_shape(world, node, index);
+        }
         let file = self.file;
         let shape = parse_shape(self, node, index)?;
         // Spawned and given its components in this order, so that the
@@ -467,16 +482,16 @@ impl Loader<'_> {
             let PendingSequence {
                 pattern,
                 location,
-                flip_tex_coords,
+                options,
             } = pending;
             let path = crate::world::systems::sequence_path(&pattern, timeline.start);
-            let first = obj::load_obj_frame(&path, flip_tex_coords)
+            let first = mesh::load_frame(&path, options)
                 .map_err(|m| SceneError::new(self.file, location, m))?;
             let first = Arc::new(first);
             let sequence = MeshSequence {
                 pattern,
                 location,
-                flip_tex_coords,
+                options,
                 topology: first.clone(),
             };
             world
@@ -808,8 +823,8 @@ struct PendingSequence {
     pattern: PathBuf,
     /// Where `filename` was written.
     location: Option<Location>,
-    /// Whether texture coordinates are read as (u, 1 − v).
-    flip_tex_coords: bool,
+    /// How each frame's file is read.
+    options: mesh::MeshOptions,
 }
 
 #[derive(Deserialize)]
@@ -903,39 +918,29 @@ fn parse_shape(loader: &mut Loader<'_>, node: &Node, index: usize) -> Result<Sha
                     return Err(SceneError::new(
                         file,
                         loc(filename_node.span()),
-                        "`filename` must be a path to an OBJ file",
+                        "`filename` must be a path to an OBJ or PLY file",
                     ));
                 }
             };
-            let flip_tex_coords = match map.get("flip_tex_coords") {
-                None => true,
-                Some(n) => n.as_scalar().and_then(|s| s.as_bool()).ok_or_else(|| {
-                    SceneError::new(
-                        file,
-                        loc(n.span()),
-                        "`flip_tex_coords` must be true or false",
-                    )
-                })?,
+            let options = mesh::MeshOptions {
+                flip_tex_coords: parse_flag(file, map.get("flip_tex_coords"), "flip_tex_coords")?,
+                face_normals: parse_flag(file, map.get("face_normals"), "face_normals")?
+                    .unwrap_or(false),
             };
+            const MESH_KEYS: &[&str] = &["filename", "flip_tex_coords", "face_normals"];
             if filename.contains('#') {
                 // A deforming mesh: its frames are read once the frame
                 // range is known; until then, an empty mesh.
                 sequence = Some(PendingSequence {
                     pattern: dir.join(&filename),
                     location: file_loc,
-                    flip_tex_coords,
+                    options,
                 });
-                (
-                    Geometry::Mesh(Arc::default()),
-                    &["filename", "flip_tex_coords"],
-                )
+                (Geometry::Mesh(Arc::default()), MESH_KEYS)
             } else {
-                let mesh = obj::load_obj(&dir.join(&filename), flip_tex_coords)
+                let mesh = mesh::load(&dir.join(&filename), options)
                     .map_err(|msg| SceneError::new(file, file_loc, msg))?;
-                (
-                    Geometry::Mesh(Arc::new(mesh)),
-                    &["filename", "flip_tex_coords"],
-                )
+                (Geometry::Mesh(Arc::new(mesh)), MESH_KEYS)
             }
         }
         other => {
@@ -989,6 +994,27 @@ fn parse_shape(loader: &mut Loader<'_>, node: &Node, index: usize) -> Result<Sha
         sphere,
         sequence,
     })
+}
+
+/// Whether `node` is a mapping whose `type` is `type_name`.
+fn type_is(node: &Node, type_name: &str) -> bool {
+    node.as_mapping()
+        .and_then(|m| m.get_scalar("type"))
+        .is_some_and(|t| t.as_str() == type_name)
+}
+
+/// A `true`/`false` value of the key `key`, where it is given.
+fn parse_flag(file: &Path, node: Option<&Node>, key: &str) -> Result<Option<bool>, SceneError> {
+    node.map(|n| {
+        n.as_scalar().and_then(|s| s.as_bool()).ok_or_else(|| {
+            SceneError::new(
+                file,
+                loc(n.span()),
+                format!("`{key}` must be true or false"),
+            )
+        })
+    })
+    .transpose()
 }
 
 fn is_similarity(m: DMat4) -> bool {

@@ -259,8 +259,8 @@ pub struct MeshSequence {
     pub pattern: PathBuf,
     /// Where `filename` was written.
     pub location: Option<Location>,
-    /// Whether texture coordinates are read as (u, 1 − v).
-    pub flip_tex_coords: bool,
+    /// How each frame's file is read.
+    pub options: crate::scene::mesh::MeshOptions,
     /// The first frame's mesh: every frame must have its triangles.
     pub topology: Arc<MeshData>,
 }
@@ -299,6 +299,9 @@ pub struct MeshData {
     pub triangles: Vec<[u32; 3]>,
     /// What loading repaired.
     pub repairs: MeshRepairs,
+    /// Whether `normals` were computed on load (the file had none): a
+    /// blend of two frames of a deforming mesh computes them again.
+    pub computed_normals: bool,
     /// The file the mesh was read from, for messages.
     pub source: String,
 }

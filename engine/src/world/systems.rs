@@ -199,7 +199,8 @@ pub fn substitute_frame(text: &str, frame: i64) -> String {
 }
 
 /// The mesh of a sequence at frame position `at` (fractional between
-/// files: positions and normals blend linearly), clamped to the
+/// files: positions and the file's normals blend linearly, computed
+/// normals are computed from the blend), clamped to the
 /// timeline's frames.
 fn mesh_at(
     sequence: &MeshSequence,
@@ -220,7 +221,12 @@ fn mesh_at(
     for (p, q) in mesh.positions.iter_mut().zip(&b.positions) {
         *p = p.lerp(*q, s);
     }
-    if let (Some(n), Some(m)) = (&mut mesh.normals, &b.normals) {
+    if mesh.computed_normals {
+        // Normals computed from each file's positions are computed again
+        // from the blend's, as the file between the two would have them.
+        mesh.normals = None;
+        crate::scene::mesh::shade(&mut mesh, false);
+    } else if let (Some(n), Some(m)) = (&mut mesh.normals, &b.normals) {
         for (n, m) in n.iter_mut().zip(m) {
             *n = n.lerp(*m, s).normalize_or_zero();
         }
@@ -236,8 +242,8 @@ fn load_frame(
 ) -> Result<Arc<MeshData>, SceneError> {
     let path = sequence_path(&sequence.pattern, frame);
     let at = |message: String| SceneError::new(scene_file, sequence.location, message);
-    let mesh = crate::scene::obj::load_obj_frame(&path, sequence.flip_tex_coords).map_err(at)?;
-    crate::scene::obj::check_topology(&sequence.topology, &mesh).map_err(at)?;
+    let mesh = crate::scene::mesh::load_frame(&path, sequence.options).map_err(at)?;
+    crate::scene::mesh::check_topology(&sequence.topology, &mesh).map_err(at)?;
     Ok(Arc::new(mesh))
 }
 
