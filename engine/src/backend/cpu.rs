@@ -10,6 +10,7 @@
 use super::RenderError;
 pub use super::{Progress, Rendered, Written};
 use crate::extract::RenderScene;
+use crate::film::aov::{AovFilm, AovImage, AovTile};
 use crate::film::band::Bands;
 use crate::film::encode::{RowSink, write_encoded};
 use crate::film::memory::FrameTooLarge;
@@ -51,6 +52,45 @@ pub fn try_render(scene: &RenderScene, progress: &Progress<'_>) -> Result<Render
         samples: pass.samples,
         rays: pass.rays,
         invalid_samples: film.invalid_samples,
+    })
+}
+
+/// Renders `scene` as [`try_render`] does (the same image, bit for bit)
+/// and also its output variables and alpha (see [`crate::film::aov`]):
+/// the planes encoders and the denoiser read beside the image. The whole
+/// film is held. Fails before any sample is traced where the films do not
+/// fit in memory.
+pub fn render_with_aovs(
+    scene: &RenderScene,
+    progress: &Progress<'_>,
+) -> Result<(Rendered, AovImage), FrameTooLarge> {
+    let s = &scene.settings;
+    let mut film = Film::try_new(s.width, s.height)?;
+    let mut aovs = AovFilm::try_new(s.width, s.height)?;
+    let pass = render_samples_with_aovs(scene, &mut film, &mut aovs, 0..s.spp, progress);
+    let rendered = Rendered {
+        image: film.try_develop()?,
+        time: pass.time,
+        samples: pass.samples,
+        rays: pass.rays,
+        invalid_samples: film.invalid_samples,
+    };
+    Ok((rendered, aovs.develop()))
+}
+
+/// [`render_samples`] that also adds the camera rays' first hits to
+/// `aovs` (whole films both): progressive rendering of the image and its
+/// output variables.
+pub fn render_samples_with_aovs(
+    scene: &RenderScene,
+    film: &mut Film,
+    aovs: &mut AovFilm,
+    samples: Range<u32>,
+    progress: &Progress<'_>,
+) -> Pass {
+    Tiler::new(scene, samples, progress).whole(Tiler::render_aovs, |(tile, aov)| {
+        film.merge(tile);
+        aovs.merge(aov);
     })
 }
 
@@ -123,21 +163,7 @@ pub fn render_samples(
     samples: Range<u32>,
     progress: &Progress<'_>,
 ) -> Pass {
-    let start = Instant::now();
-    let tiler = Tiler::new(scene, samples, progress);
-    let mut rays = 0;
-    for group in tiler.bands(group_tile_rows(scene.settings.width)).groups() {
-        let (tiles, r) = tiler.render(group);
-        for tile in &tiles {
-            film.merge(tile);
-        }
-        rays += r;
-    }
-    Pass {
-        time: start.elapsed(),
-        samples: tiler.total,
-        rays,
-    }
+    Tiler::new(scene, samples, progress).whole(Tiler::render, |tile| film.merge(tile))
 }
 
 /// Renders every sample of `scene` in groups of `group` tile rows and
@@ -225,6 +251,31 @@ impl<'a> Tiler<'a> {
         Bands::new(s.width, s.height, TILE, group, self.reconstruction.reach())
     }
 
+    /// Renders the whole frame, a group of tile rows at a time, with
+    /// `render` (a method below) and hands each group's tiles to `merge` in
+    /// tile order.
+    fn whole<T>(
+        &self,
+        render: impl Fn(&Self, Range<u32>) -> (Vec<T>, u64),
+        mut merge: impl FnMut(&T),
+    ) -> Pass {
+        let start = Instant::now();
+        let mut rays = 0;
+        for group in self
+            .bands(group_tile_rows(self.scene.settings.width))
+            .groups()
+        {
+            let (tiles, r) = render(self, group);
+            tiles.iter().for_each(&mut merge);
+            rays += r;
+        }
+        Pass {
+            time: start.elapsed(),
+            samples: self.total,
+            rays,
+        }
+    }
+
     /// Renders the tiles of tile rows `rows` on the pool's threads; returns
     /// their films in tile order (row by row, left to right) and the rays
     /// they traced.
@@ -235,14 +286,47 @@ impl<'a> Tiler<'a> {
             .collect();
         let results: Vec<(TileFilm, u64)> = tiles
             .par_iter()
-            .map_init(Wavefront::default, |wave, &tile| self.tile(wave, tile))
+            .map_init(Wavefront::default, |wave, &tile| {
+                self.tile(wave, tile, None)
+            })
             .collect();
         let rays = results.iter().map(|(_, r)| r).sum();
         (results.into_iter().map(|(tile, _)| tile).collect(), rays)
     }
 
-    /// Renders the tile whose top left pixel is (`x0`, `y0`).
-    fn tile(&self, wave: &mut Wavefront, (x0, y0): (u32, u32)) -> (TileFilm, u64) {
+    /// Renders the tiles of tile rows `rows` as [`Tiler::render`] does and
+    /// records their first hits: each tile's film and output variables, in
+    /// tile order, and the rays traced.
+    fn render_aovs(&self, rows: Range<u32>) -> (Vec<(TileFilm, AovTile)>, u64) {
+        let s = &self.scene.settings;
+        let columns = s.width.div_ceil(TILE);
+        let tiles: Vec<(u32, u32)> = rows
+            .flat_map(|ty| (0..columns).map(move |tx| (tx * TILE, ty * TILE)))
+            .collect();
+        let results: Vec<(TileFilm, AovTile, u64)> = tiles
+            .par_iter()
+            .map_init(Wavefront::default, |wave, &(x0, y0)| {
+                let (x1, y1) = ((x0 + TILE).min(s.width), (y0 + TILE).min(s.height));
+                let size = (s.width, s.height);
+                let reach = self.reconstruction.reach();
+                let mut aovs = AovTile::new(x0, y0, x1, y1, size, reach);
+                let (tile, rays) = self.tile(wave, (x0, y0), Some(&mut aovs));
+                (tile, aovs, rays)
+            })
+            .collect();
+        let rays = results.iter().map(|(_, _, r)| r).sum();
+        let tiles = results.into_iter().map(|(t, a, _)| (t, a)).collect();
+        (tiles, rays)
+    }
+
+    /// Renders the tile whose top left pixel is (`x0`, `y0`), adding its
+    /// camera rays' first hits to `aovs` where given.
+    fn tile(
+        &self,
+        wave: &mut Wavefront,
+        (x0, y0): (u32, u32),
+        mut aovs: Option<&mut AovTile>,
+    ) -> (TileFilm, u64) {
         let (w, h) = (self.scene.settings.width, self.scene.settings.height);
         let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
         let pixels = (x1 - x0) * (y1 - y0);
@@ -260,7 +344,12 @@ impl<'a> Tiler<'a> {
                 first_sample: first,
                 samples: count,
             };
-            wave.render(self.scene, batch, &self.reconstruction, &mut tile);
+            match aovs.as_deref_mut() {
+                Some(a) => {
+                    wave.render_with_aovs(self.scene, batch, &self.reconstruction, &mut tile, a)
+                }
+                None => wave.render(self.scene, batch, &self.reconstruction, &mut tile),
+            }
             first += count;
             if self.progress.is_active() {
                 let n = pixels as u64 * count as u64;
@@ -273,7 +362,7 @@ impl<'a> Tiler<'a> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::extract::{Overrides, extract};
     use crate::film::Image;
@@ -281,7 +370,7 @@ mod tests {
     use std::path::Path;
 
     /// The Cornell box at `width`×`height` pixels and `spp`.
-    fn cornell_scene(width: u32, height: u32, spp: u32) -> RenderScene {
+    pub(crate) fn cornell_scene(width: u32, height: u32, spp: u32) -> RenderScene {
         // `expect` in this test code is the assertion: the committed scene
         // loads and extracts.
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/cornell-box.yaml");

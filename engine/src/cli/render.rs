@@ -2,6 +2,7 @@
 //! files.
 
 mod partition;
+mod passes;
 
 use super::diagnostic::report;
 use super::film_args::FilmArgs;
@@ -77,6 +78,8 @@ pub struct RenderArgs {
     partition: Option<radiant::farm::partition::Partition>,
     #[command(flatten)]
     film: FilmArgs,
+    #[command(flatten)]
+    passes: passes::PassArgs,
 }
 
 impl RenderArgs {
@@ -195,6 +198,7 @@ struct Totals {
 
 /// Renders as the arguments say.
 pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
+    passes::check(args)?;
     if let Some(p) = args.partition {
         return partition::run(registry, args, p);
     }
@@ -216,6 +220,7 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         output: args.encoding.overrides(),
         ..args.sampling.overrides(&args.film)
     };
+    let overrides = args.passes.overrides(overrides);
     let options = SequenceOptions {
         lock_noise: args.lock_noise,
         ..SequenceOptions::default()
@@ -257,7 +262,12 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
             Some(b) => b,
             None => backend.insert(
                 choose(
-                    args.backend,
+                    // First-hit planes are recorded on the CPU.
+                    if args.passes.wanted() {
+                        BackendKind::Cpu
+                    } else {
+                        args.backend
+                    },
                     &radiant::backend::gpu::GpuOptions {
                         stats: args.gpu_stats,
                         kernel: args.gpu_kernel,
@@ -285,9 +295,17 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         let base = totals.frames * per_frame;
         let progress = |done: u64, _total: u64| bar.set_position(base + done);
         let path = frame_path(&args.output, frame);
-        let rendered = pool
-            .install(|| backend.write(s, &path, &Progress::new(&progress)))
-            .map_err(|e| miette::miette!("{e}"))?;
+        let rendered = pool.install(|| {
+            let progress = Progress::new(&progress);
+            if args.passes.wanted() {
+                let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
+                passes::write(&args.passes, s, &path, &progress, &note)
+            } else {
+                backend
+                    .write(s, &path, &progress)
+                    .map_err(|e| miette::miette!("{e}"))
+            }
+        })?;
         if rendered.invalid_samples > 0 {
             bar.suspend(|| {
                 eprintln!(

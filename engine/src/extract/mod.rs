@@ -145,6 +145,9 @@ pub struct RenderScene {
     /// with) to its pose at shutter time τ; `None` where the camera does
     /// not move.
     pub camera_motion: Option<Motion>,
+    /// Where render space's origin lies in world space (render space is
+    /// world space translated by −`render_origin`).
+    pub render_origin: glam::DVec3,
     /// The pixel filter.
     pub filter: Box<dyn Filter>,
     /// The sampler.

@@ -213,6 +213,7 @@ pub(super) fn build(
         lights: initial.lights,
         camera: initial.camera,
         camera_motion: camera_motion(scene, render_origin),
+        render_origin,
         filter: initial.filter,
         sampler: initial.sampler,
         textures: initial.textures,

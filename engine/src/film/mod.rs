@@ -9,9 +9,12 @@
 //! filter's reach ([`FilterTable`]), or placed by filter importance
 //! sampling and added to one pixel ([`FilterSampler`], pbrt-v4).
 
+pub mod aov;
 pub mod band;
+pub mod denoise;
 pub mod encode;
 pub mod encoding;
+pub mod layers;
 pub mod memory;
 pub mod output;
 pub mod rgbe;

@@ -22,11 +22,12 @@ use super::surface::{Derivatives, Interaction, interaction, interaction_with_der
 use crate::accel::offset::{offset_origin, sampled_point_error};
 use crate::accel::{Hit, Motion};
 use crate::extract::{NO_EMITTER, RenderScene};
+use crate::film::aov::{AovTile, FirstHit};
 use crate::film::{Reconstruction, TileFilm};
 use glam::{Vec2, Vec3};
 use radiant_core::{
     BsdfEval, BsdfSample, CameraRays, Effects, EmitterEval, EmitterHit, LightSample, Rgb, SampleId,
-    ShadeContext, SurfaceBatch,
+    ShadeContext, Shader, SurfaceBatch,
 };
 
 /// Sampler dimensions used by the camera (film jitter, lens); under motion
@@ -131,6 +132,13 @@ pub struct Wavefront {
     shadow_time: Vec<f32>,
     /// Per shadow ray: whether something blocks it.
     shadow_blocked: Vec<bool>,
+    // Output variables (only while a batch collects them).
+    /// Whether this batch records its camera rays' first hits.
+    collect_aovs: bool,
+    /// What each camera path's first segment found, by slot.
+    first_hits: Vec<FirstHit>,
+    /// The first hits' albedos, per live path in material order.
+    albedo_k: Vec<Rgb>,
     /// Rays traced so far (camera, continuation and shadow rays).
     pub rays: u64,
 }
@@ -175,6 +183,28 @@ fn bsdf_hit_weight(depth: u32, bsdf_pdf: f32, light_pdf: f32) -> f32 {
     }
 }
 
+/// The shading inputs `wo`, `dp_du`, `dp_dv` (`vectors`) and `uv` of the
+/// live paths `k` (material order) for `shader`: with surface derivatives
+/// only where it needs tangent frames.
+fn surface_batch<'a>(
+    shader: &dyn Shader,
+    [wo, dp_du, dp_dv]: [&'a [Vec3]; 3],
+    uv: &'a [Vec2],
+    k: std::ops::Range<usize>,
+) -> SurfaceBatch<'a> {
+    let batch = SurfaceBatch::new(wo, uv);
+    if shader.effects().contains(Effects::TANGENT_FRAMES) {
+        SurfaceBatch {
+            dp_du,
+            dp_dv,
+            ..batch
+        }
+        .slice(k)
+    } else {
+        batch.slice(k)
+    }
+}
+
 impl Wavefront {
     /// Renders `batch` and adds its samples to `tile`.
     pub fn render(
@@ -184,8 +214,36 @@ impl Wavefront {
         reconstruction: &Reconstruction,
         tile: &mut TileFilm,
     ) {
+        self.render_batch(scene, batch, reconstruction, tile, None);
+    }
+
+    /// Renders `batch` as [`Wavefront::render`] does (the same samples)
+    /// and also adds its camera rays' first hits to `aovs`.
+    pub fn render_with_aovs(
+        &mut self,
+        scene: &RenderScene,
+        batch: Batch,
+        reconstruction: &Reconstruction,
+        tile: &mut TileFilm,
+        aovs: &mut AovTile,
+    ) {
+        self.render_batch(scene, batch, reconstruction, tile, Some(aovs));
+    }
+
+    fn render_batch(
+        &mut self,
+        scene: &RenderScene,
+        batch: Batch,
+        reconstruction: &Reconstruction,
+        tile: &mut TileFilm,
+        aovs: Option<&mut AovTile>,
+    ) {
         let n = ((batch.x1 - batch.x0) * (batch.y1 - batch.y0) * batch.samples) as usize;
         self.generate(scene, batch, n, reconstruction);
+        self.collect_aovs = aovs.is_some();
+        if self.collect_aovs {
+            zeroed(&mut self.first_hits, n);
+        }
         if scene.settings.max_depth != 0 {
             self.trace_paths(scene);
         }
@@ -207,6 +265,15 @@ impl Wavefront {
                     );
                 }
             }
+        }
+        if let Some(aovs) = aovs {
+            aovs.add_samples(
+                reconstruction,
+                self.ids[..n].iter().map(|id| id.pixel),
+                &self.film[..n],
+                &self.filter_weight,
+                &self.first_hits[..n],
+            );
         }
     }
 
@@ -322,10 +389,17 @@ impl Wavefront {
             if has_env {
                 self.add_escaped(scene, depth);
             }
-            if depth + 1 >= max_depth {
+            let first_hits = depth == 0 && self.collect_aovs;
+            if depth + 1 >= max_depth && !first_hits {
                 break;
             }
             let n = self.sort_by_material(scene);
+            if first_hits {
+                self.record_first_hits(scene, n);
+                if depth + 1 >= max_depth {
+                    break;
+                }
+            }
             let base = camera_dims + depth * BOUNCE_DIMS;
             if has_lights {
                 self.sample_lights(scene, n, base);
@@ -500,6 +574,40 @@ impl Wavefront {
         n
     }
 
+    /// Records what the camera rays that hit a surface found (the live
+    /// paths after [`Wavefront::sort_by_material`] at depth 0): one
+    /// `Shader::albedo` call per material.
+    fn record_first_hits(&mut self, scene: &RenderScene, n: usize) {
+        fit(&mut self.albedo_k, n);
+        let mut ctx = ShadeContext::new(&scene.textures);
+        for (m, shader) in scene.shaders.iter().enumerate() {
+            let (a, b) = (self.offsets[m] as usize, self.offsets[m + 1] as usize);
+            if a == b {
+                continue;
+            }
+            let surface = surface_batch(
+                shader.as_ref(),
+                [&self.wo, &self.dp_du, &self.dp_dv],
+                &self.uv,
+                a..b,
+            );
+            shader.albedo(&mut ctx, surface, &mut self.albedo_k[a..b]);
+        }
+        let (its, origin) = (&self.its[..], &self.origin[..]);
+        let to_world = scene.render_origin;
+        for (&slot, &albedo) in self.live[..n].iter().zip(&self.albedo_k) {
+            let i = slot as usize;
+            let it = &its[i];
+            self.first_hits[i] = FirstHit {
+                alpha: 1.0,
+                albedo,
+                normal: it.frame.n,
+                depth: (it.p - origin[i]).length(),
+                position: (it.p.as_dvec3() + to_world).as_vec3(),
+            };
+        }
+    }
+
     /// Chooses a light per path and samples a point on it, one module call
     /// per light.
     fn sample_lights(&mut self, scene: &RenderScene, n: usize, base: u32) {
@@ -600,16 +708,12 @@ impl Wavefront {
             if a == b {
                 continue;
             }
-            let surface = if shader.effects().contains(Effects::TANGENT_FRAMES) {
-                SurfaceBatch {
-                    wo: &self.wo[a..b],
-                    uv: &self.uv[a..b],
-                    dp_du: &self.dp_du[a..b],
-                    dp_dv: &self.dp_dv[a..b],
-                }
-            } else {
-                SurfaceBatch::new(&self.wo[a..b], &self.uv[a..b])
-            };
+            let surface = surface_batch(
+                shader.as_ref(),
+                [&self.wo, &self.dp_du, &self.dp_dv],
+                &self.uv,
+                a..b,
+            );
             shader.sample(&mut ctx, surface, &self.u3[a..b], &mut self.bsdf[a..b]);
             if has_lights && shader.effects().contains(Effects::SMOOTH_LOBES) {
                 shader.eval(

@@ -54,7 +54,9 @@ pub use light::{EmitterEval, EmitterHit, Light, LightSample};
 pub use params::{Color, Numbers, ParamError, Params, TextureInput};
 pub use registry::{ModuleInfo, ModuleKind, ParamDoc, Registry};
 pub use sampler::{SampleId, Sampler};
-pub use shader::{BsdfEval, BsdfSample, Pooled, Scratch, ShadeContext, Shader, SurfaceBatch};
+pub use shader::{
+    BsdfEval, BsdfSample, Pooled, Scratch, ShadeContext, Shader, SurfaceBatch, estimate_albedo,
+};
 pub use shading::{fraction, reflection_sample};
 pub use texture::{Texture, TextureId, TextureRef, TextureTable};
 

@@ -255,6 +255,19 @@ pub trait Shader: Send + Sync {
         out: &mut [BsdfEval],
     );
 
+    /// The surface's albedo seen from each `wo`: the fraction of light it
+    /// scatters (reflected and transmitted, with refraction's 1/η² radiance
+    /// scaling undone), clamped to [0, 1]. The integrator asks for it only
+    /// where an `albedo` pass or the denoiser needs it (the albedo guide of
+    /// Open Image Denoise: a matte surface's colour, a metal's specular
+    /// colour, 1 for clear glass). The default, [`estimate_albedo`], is the
+    /// mean sample weight over a fixed stratified set of samples — exact
+    /// for a Lambertian or perfectly specular lobe; a shader may override
+    /// it with a closed form.
+    fn albedo(&self, ctx: &mut ShadeContext<'_>, surface: SurfaceBatch<'_>, out: &mut [Rgb]) {
+        estimate_albedo(self, ctx, surface, out);
+    }
+
     /// The shader's GPU side (see [`crate::gpu`]), `None` where the type has
     /// none (the GPU backend then refuses the scene, naming it).
     fn gpu(&self) -> Option<GpuModule> {
@@ -262,4 +275,49 @@ pub trait Shader: Send + Sync {
     }
     /// Effects this shader needs (its lobes, its textures).
     fn effects(&self) -> Effects;
+}
+
+/// Samples per point of [`estimate_albedo`]: a 4×4 grid of the direction's
+/// 2D sample, each with its own lobe choice.
+pub const ALBEDO_SAMPLES: u32 = 16;
+
+/// The albedo of each surface point of `surface` (see [`Shader::albedo`]):
+/// the mean of `shader`'s sample weights (times η², undoing refraction's
+/// radiance scaling) over [`ALBEDO_SAMPLES`] fixed stratified samples,
+/// clamped to [0, 1]. The samples are the same for every point, so the
+/// estimate is deterministic and uses none of the sampler's dimensions.
+pub fn estimate_albedo<S: Shader + ?Sized>(
+    shader: &S,
+    ctx: &mut ShadeContext<'_>,
+    surface: SurfaceBatch<'_>,
+    out: &mut [Rgb],
+) {
+    let n = surface.len();
+    let out = &mut out[..n];
+    out.fill(Rgb::ZERO);
+    let mut u = ctx.take::<Vec3>(n);
+    let mut samples = ctx.take::<BsdfSample>(n);
+    for k in 0..ALBEDO_SAMPLES {
+        let (i, j) = (k % 4, k / 4);
+        // Lobe choices in a permuted order, so that they do not follow the
+        // grid's rows.
+        let choice = ((k * 7) % ALBEDO_SAMPLES) as f32 + 0.5;
+        u.fill(Vec3::new(
+            choice / ALBEDO_SAMPLES as f32,
+            (i as f32 + 0.5) / 4.0,
+            (j as f32 + 0.5) / 4.0,
+        ));
+        shader.sample(ctx, surface, &u, &mut samples);
+        for (o, s) in out.iter_mut().zip(&samples) {
+            let w = s.weight * (s.eta * s.eta);
+            if s.pdf > 0.0 && w.is_finite() {
+                *o += w;
+            }
+        }
+    }
+    for o in out.iter_mut() {
+        *o = (*o / ALBEDO_SAMPLES as f32).clamp(Rgb::ZERO, Rgb::ONE);
+    }
+    ctx.recycle(u);
+    ctx.recycle(samples);
 }

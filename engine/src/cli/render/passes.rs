@@ -1,0 +1,147 @@
+//! `radiant render --aov LIST` and `--denoise`: renders a frame with its
+//! first-hit planes (`radiant::film::aov`) on the CPU, denoises it with
+//! Open Image Denoise where asked (`radiant::film::denoise`), and writes
+//! the image, with the planes as layers of one EXR where asked
+//! (`radiant::film::layers`).
+
+use super::RenderArgs;
+use clap::Args;
+use radiant::backend::{BackendKind, Progress, Written, cpu};
+use radiant::extract::{Overrides, RenderScene};
+use radiant::film::aov::{self, Aov};
+use radiant::film::denoise::{Denoiser, Guides};
+use radiant::film::{layers, output};
+use radiant::settings::FilterSampling;
+use std::path::Path;
+use std::time::Instant;
+
+/// The options of the planes and the denoiser.
+#[derive(Args, Clone, Default)]
+pub struct PassArgs {
+    /// Output variables to write as layers of the EXR, comma-separated:
+    /// albedo, normal, depth, position, spp (channels `albedo.R/G/B`,
+    /// `normal.X/Y/Z`, `depth.Z`, `position.X/Y/Z`, `spp.Y`; the beauty's
+    /// alpha goes to `A`). Renders on the CPU.
+    #[arg(long, value_parser = parse_aovs)]
+    pub aov: Option<AovList>,
+    /// Denoise the image with Intel Open Image Denoise, guided by the
+    /// first hits' albedo and normals (see the README, "Denoising").
+    #[arg(long)]
+    pub denoise: bool,
+}
+
+/// A parsed `--aov` list.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct AovList(pub Vec<Aov>);
+
+fn parse_aovs(text: &str) -> Result<AovList, String> {
+    aov::parse_list(text)
+        .map(AovList)
+        .map_err(|e| e.to_string())
+}
+
+impl PassArgs {
+    /// The output variables `--aov` asks for.
+    fn aovs(&self) -> &[Aov] {
+        self.aov.as_ref().map_or(&[], |l| &l.0)
+    }
+
+    /// `overrides` as the passes need them: `--denoise` samples the pixel
+    /// filter by importance (`film: {filter_sampling: importance}`), since
+    /// OIDN expects independent noise in each pixel and splatting
+    /// correlates neighbours, which it keeps as detail (16-spp Cornell box:
+    /// relMSE 8.5e-4 denoised against 4.6e-3 splatted; `tests/denoise.rs`).
+    pub(super) fn overrides(&self, overrides: Overrides) -> Overrides {
+        if self.denoise {
+            Overrides {
+                filter_sampling: Some(FilterSampling::Importance),
+                ..overrides
+            }
+        } else {
+            overrides
+        }
+    }
+
+    /// Whether frames render through [`write`].
+    pub(super) fn wanted(&self) -> bool {
+        self.denoise || !self.aovs().is_empty()
+    }
+}
+
+/// Checks, before anything renders, that the passes can be made as asked:
+/// by the CPU backend, into an EXR where there are layers, not into a
+/// partition.
+pub(super) fn check(args: &RenderArgs) -> miette::Result<()> {
+    let passes = &args.passes;
+    if !passes.wanted() {
+        return Ok(());
+    }
+    let what = if passes.denoise { "--denoise" } else { "--aov" };
+    if args.backend == BackendKind::Gpu {
+        miette::bail!(
+            "{what} needs the CPU backend: the GPU kernel does not record first hits yet; \
+             use `--backend cpu` (or `auto`, which renders such frames on the CPU)"
+        );
+    }
+    if args.partition.is_some() {
+        miette::bail!(
+            "{what} cannot be used with --partition: a partition holds sums for `radiant merge`; \
+             render the passes with a whole render"
+        );
+    }
+    if !passes.aovs().is_empty() && !is_exr(&args.output) {
+        miette::bail!(
+            "--aov writes layers of an EXR file, and `{}` is not one: name the output .exr",
+            args.output.display()
+        );
+    }
+    Ok(())
+}
+
+fn is_exr(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+}
+
+/// Renders `scene` with its planes on the CPU, denoises it where asked and
+/// writes `path` (atomically); says on stderr how long denoising took.
+pub(super) fn write(
+    args: &PassArgs,
+    scene: &RenderScene,
+    path: &Path,
+    progress: &Progress<'_>,
+    note: &dyn Fn(&str),
+) -> miette::Result<Written> {
+    let aovs = args.aovs();
+    // Loaded before rendering, so that a missing library costs no render.
+    let denoiser = args
+        .denoise
+        .then(Denoiser::load)
+        .transpose()
+        .map_err(|e| miette::miette!("{e}"))?;
+    let (rendered, planes) =
+        cpu::render_with_aovs(scene, progress).map_err(|e| miette::miette!("{e}"))?;
+    let written = Written::from(&rendered);
+    let image = match &denoiser {
+        Some(d) => {
+            let start = Instant::now();
+            let image = d
+                .denoise(&rendered.image, &planes, Guides::of(scene))
+                .map_err(|e| miette::miette!("{e}"))?;
+            note(&format!(
+                "denoised in {:.2} s (Open Image Denoise from {})",
+                start.elapsed().as_secs_f64(),
+                d.path().display()
+            ));
+            image
+        }
+        None => rendered.image,
+    };
+    if aovs.is_empty() {
+        output::write_encoded(path, &image, &scene.settings.output)
+    } else {
+        layers::write(path, &image, &planes, aovs)
+    }
+    .map_err(|e| miette::miette!("{e}"))?;
+    Ok(written)
+}
