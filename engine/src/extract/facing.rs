@@ -96,9 +96,7 @@ pub fn back_facing(scene: &RenderScene) -> Vec<BackFacing> {
     seen.iter()
         .enumerate()
         .filter(|&(m, &(front, back))| {
-            let two_sided = scene.shaders[m]
-                .effects()
-                .intersects(Effects::TRANSMISSION | Effects::NULL_INTERFACE);
+            let two_sided = scene.shaders[m].effects().contains(Effects::TRANSMISSION);
             !two_sided && back > front && back as f32 >= MIN_SHARE * rays
         })
         .map(|(m, &(front, back))| BackFacing {
