@@ -61,5 +61,6 @@ pub fn builtin_registry() -> Registry {
     radiant_shaders::register(&mut registry);
     radiant_samplers::register(&mut registry);
     radiant_textures::register(&mut registry);
+    radiant_media::register(&mut registry);
     registry
 }

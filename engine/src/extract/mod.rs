@@ -26,11 +26,13 @@ pub mod facing;
 mod geometry;
 mod lights;
 mod materials;
+mod media;
 mod modules;
 mod sequence;
 mod shapes;
 
 pub use lights::LightTable;
+pub use media::MediaTable;
 pub use sequence::{FrameUpdate, Sequence, SequenceOptions};
 pub(crate) use shapes::BARYCENTRIC_UVS;
 
@@ -154,6 +156,8 @@ pub struct RenderScene {
     pub sampler: Box<dyn Sampler>,
     /// The textures.
     pub textures: TextureTable,
+    /// The participating media (empty for scenes without any).
+    pub media: MediaTable,
     /// The light-transport features the frame needs.
     pub effects: Effects,
     /// The module types in use.

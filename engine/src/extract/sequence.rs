@@ -193,8 +193,9 @@ pub(super) fn build(
         &mut stats,
     )?;
     let sphere = geometry.scene_sphere(&accel);
-    let (modules, initial) =
+    let (modules, mut initial) =
         ModuleState::build(scene, registry, &settings, render_origin, emitters, sphere)?;
+    let media = super::MediaTable::build(scene, registry, &initial.shaders, &mut initial.modules)?;
     let mut render = RenderScene {
         settings,
         frame,
@@ -217,6 +218,7 @@ pub(super) fn build(
         filter: initial.filter,
         sampler: initial.sampler,
         textures: initial.textures,
+        media,
         effects: Effects::empty(),
         modules: initial.modules,
         stats,
@@ -252,6 +254,9 @@ fn effects(render: &RenderScene) -> Effects {
         || render.accel.blases().iter().any(|b| b.deforms());
     if moving {
         effects |= Effects::MOTION_BLUR;
+    }
+    if render.media.in_use() {
+        effects |= Effects::MEDIA;
     }
     effects
 }

@@ -5,6 +5,7 @@
 //! → emission → sort by material → shade → next-event estimation → shadow
 //! rays → continue/compact, and finally splats into the film.
 
+mod medium;
 pub mod path;
 mod sort;
 pub mod surface;

@@ -17,6 +17,7 @@
 //! the live paths' slots (structure of arrays); modules are called once per
 //! group of paths that share a material or a light.
 
+use super::medium::{self, MEDIUM_DIMS, MediumState};
 use super::sort::sort_by_key;
 use super::surface::{Derivatives, Interaction, interaction, interaction_with_derivatives};
 use crate::accel::offset::{offset_origin, sampled_point_error};
@@ -140,6 +141,8 @@ pub struct Wavefront {
     /// The first hits' albedos, per live path in material order.
     albedo_k: Vec<Rgb>,
     /// Rays traced so far (camera, continuation and shadow rays).
+    /// Medium state (only in frames with media; see `integrators/medium.rs`).
+    media: MediumState,
     pub rays: u64,
 }
 
@@ -394,13 +397,33 @@ impl Wavefront {
                 break;
             }
             let n = self.sort_by_material(scene);
+        let has_media = medium::active(scene);
+        let bounce_dims = BOUNCE_DIMS + if has_media { MEDIUM_DIMS } else { 0 };
+        if has_media {
+            self.media.start(scene, &self.origin[..self.live.len()]);
+        }
             if first_hits {
                 self.record_first_hits(scene, n);
+            let base = camera_dims + depth * bounce_dims;
                 if depth + 1 >= max_depth {
+            if has_media {
+                self.media.sample_distances(
+                    scene,
+                    base + BOUNCE_DIMS,
+                    &mut self.live,
+                    &self.ids,
+                    (&self.origin, &self.dir),
+                    &self.hit,
+                    &mut self.beta,
+                    &mut self.its,
+                );
+            }
                     break;
+            if has_media {
+                self.live.extend_from_slice(self.media.events());
+            }
                 }
             }
-            let base = camera_dims + depth * BOUNCE_DIMS;
             if has_lights {
                 self.sample_lights(scene, n, base);
             }
@@ -417,10 +440,30 @@ impl Wavefront {
         let times = scene.motion_blur().then_some(&self.time[..]);
         scene
             .accel
+            if has_media {
+                self.media.shade_events(
+                    scene,
+                    &self.offsets,
+                    &self.wo,
+                    &self.u3,
+                    &self.nee_wi,
+                    &mut self.bsdf,
+                    &mut self.nee_eval,
+                );
+            }
             .intersect_slots(&self.live, &self.origin, &self.dir, times, &mut self.hit);
         self.rays += self.live.len() as u64;
     }
 
+            if has_media {
+                self.media.after_bounce(
+                    scene,
+                    &self.live,
+                    (&self.hit, &self.its),
+                    &self.dir,
+                    &mut self.prev_pdf,
+                );
+            }
     /// Drops paths that escaped (keeping them in `esc_slots` if `has_env`),
     /// resolves hits, adds emission.
     fn resolve_hits(&mut self, scene: &RenderScene, depth: u32, has_area: bool, has_env: bool) {
@@ -486,7 +529,11 @@ impl Wavefront {
         for (k, &slot) in self.em_slots.iter().enumerate() {
             let i = slot as usize;
             self.em_hits[k] = EmitterHit {
-                origin: self.origin[i],
+                origin: if has_media {
+                    self.media.scatter_origin(i)
+                } else {
+                    self.origin[i]
+                },
                 p: self.its[i].p,
                 n: self.its[i].ng,
                 primitive: surfaces.emitter_prim[self.hit[i].prim as usize],
@@ -495,6 +542,7 @@ impl Wavefront {
         for light in 0..nlights {
             let (a, b) = (
                 self.offsets[light] as usize,
+        let has_media = medium::active(scene);
                 self.offsets[light + 1] as usize,
             );
             if a < b {
@@ -539,14 +587,32 @@ impl Wavefront {
     /// Sorts live paths by material and gathers their shading inputs.
     fn sort_by_material(&mut self, scene: &RenderScene) -> usize {
         let hits = &self.hit;
-        sort_by_key(
-            &mut self.live,
-            &mut self.scratch,
-            &mut self.cursor,
-            &mut self.offsets,
-            scene.shaders.len(),
-            |slot| scene.material(&hits[slot as usize]),
-        );
+        let materials = scene.shaders.len();
+        if medium::active(scene) {
+            // Medium events after the materials, one group per medium.
+            let media = &self.media;
+            sort_by_key(
+                &mut self.live,
+                &mut self.scratch,
+                &mut self.cursor,
+                &mut self.offsets,
+                materials + scene.media.phases.len(),
+                |slot| {
+                    media
+                        .event_group(slot, materials)
+                        .unwrap_or_else(|| scene.material(&hits[slot as usize]))
+                },
+            );
+        } else {
+            sort_by_key(
+                &mut self.live,
+                &mut self.scratch,
+                &mut self.cursor,
+                &mut self.offsets,
+                materials,
+                |slot| scene.material(&hits[slot as usize]),
+            );
+        }
         let n = self.live.len();
         fit(&mut self.ids_k, n);
         fit(&mut self.wo, n);
@@ -799,13 +865,28 @@ impl Wavefront {
         } else {
             None
         };
-        scene.accel.occluded_each(
-            &self.shadow_origin,
-            &self.shadow_dir,
-            times,
-            1.0 - SHADOW_EPSILON,
-            &mut self.shadow_blocked,
-        );
+        if medium::active(scene) {
+            // Transmittance through media and `null` boundaries; blocked
+            // rays carry zero.
+            self.media.transmittance(
+                scene,
+                &self.shadow_slot,
+                (&self.shadow_origin, &self.shadow_dir),
+                times,
+                SHADOW_EPSILON,
+                (&self.hit, &self.its),
+                &mut self.shadow_value,
+            );
+            self.shadow_blocked.fill(false);
+        } else {
+            scene.accel.occluded_each(
+                &self.shadow_origin,
+                &self.shadow_dir,
+                times,
+                1.0 - SHADOW_EPSILON,
+                &mut self.shadow_blocked,
+            );
+        }
         let radiance = &mut self.radiance[..];
         let rays = self.shadow_slot.iter().zip(&self.shadow_blocked);
         for ((&slot, &blocked), &value) in rays.zip(&self.shadow_value) {

@@ -28,6 +28,7 @@ mod instances;
 mod keyframes;
 pub mod line_limit;
 pub mod mesh;
+pub mod media;
 pub mod normals;
 pub mod obj;
 pub mod ply;
@@ -68,6 +69,8 @@ const TOP_KEYS: &[&str] = &[
     "lights",
     "animation",
 ];
+    "media",
+    "atmosphere",
 const SHAPE_TYPES: &[&str] = &["rectangle", "cube", "sphere", "mesh", "gltf"];
 const INTEGRATORS: &[&str] = &["path"];
 
@@ -90,6 +93,8 @@ struct Loader<'f> {
     materials: Vec<(String, ModuleSpec)>,
     material_ids: HashMap<String, u32>,
     /// Deforming meshes whose first frame is read once the frame range is
+    /// The scene's media and the interfaces shapes put between them.
+    media: media::SceneMedia,
     /// known: (entity, pattern, where `filename` was written).
     sequences: Vec<(hecs::Entity, PendingSequence)>,
     /// Textures that glTF materials define, added to `textures:`.
@@ -115,6 +120,7 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
         materials: named_modules(file, top.get("materials"), "material")?,
         material_ids: HashMap::new(),
         sequences: Vec::new(),
+        media: media::SceneMedia::parse(file, top.get("media"), top.get("atmosphere"))?,
         textures: Vec::new(),
     };
     loader.material_ids = loader
@@ -198,6 +204,7 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
         textures,
         materials: loader.materials,
     };
+        media: loader.media,
     crate::world::systems::animate(&mut scene, timeline.start)?;
     Ok(scene)
 }
@@ -289,11 +296,14 @@ impl Loader<'_> {
             file,
             node,
             "camera",
-            &["look_at", "transform", "animation", "shutter"],
+            &["look_at", "transform", "animation", "shutter", "medium"],
         )?;
         self.keyframes.module_tracks(&mut module)?;
         let map = node.as_mapping().expect("from_node checked the mapping");
         let (look, transform, animation) = (
+        if let Some(medium) = map.get_node("medium") {
+            self.media.camera = self.media.reference(file, Some(medium))?;
+        }
             map.get_node("look_at"),
             map.get_node("transform"),
             map.get_node("animation"),
@@ -967,8 +977,12 @@ fn parse_shape(loader: &mut Loader<'_>, node: &Node, index: usize) -> Result<Sha
         "animation",
         "instances",
     ];
+        "interior",
+        "exterior",
     keys.extend_from_slice(allowed);
     map.finish(&keys)?;
+    // Read by the media (`media.rs`) once the geometry is known.
+    let _ = (map.get("interior"), map.get("exterior"));
     let sphere = matches!(geometry, Geometry::Sphere);
     if let (true, true, Some(node)) = (sphere, flip_normals, flip_node) {
         return Err(SceneError::new(
@@ -985,6 +999,10 @@ fn parse_shape(loader: &mut Loader<'_>, node: &Node, index: usize) -> Result<Sha
         ));
     }
     Ok(ShapeDef {
+    let material = match loader.media.interface(file, node, &geometry)? {
+        Some(interface) => loader.bound_medium(material, interface, flip_normals, &name),
+        None => material,
+    };
         name: Name(name),
         transform,
         geometry,
@@ -1051,25 +1069,17 @@ fn parse_material_ref(
         }
         Some(n) if n.as_scalar().is_some() => {
             let name = n.as_scalar().expect("checked").as_str();
-            material_ids.get(name).map(|&i| MaterialRef(i)).ok_or_else(|| {
-                let mut known: Vec<&str> = materials
-                    .iter()
-                    .map(|(k, _)| k.as_str())
-                    .filter(|k| !k.starts_with('<'))
-                    .collect();
-                known.sort_unstable();
-                let hint = closest(name, &known)
-                    .map(|s| format!(" (did you mean `{s}`?)"))
-                    .unwrap_or_default();
-                SceneError::new(
-                    file,
-                    loc(n.span()),
-                    format!(
-                        "undefined material `{name}`{hint}; materials defined under `materials:`: {}",
-                        if known.is_empty() { "none".to_string() } else { known.join(", ") }
-                    ),
-                )
-            })
+            material_ids
+                .get(name)
+                .map(|&i| MaterialRef(i))
+                .ok_or_else(|| {
+                    let known = materials
+                        .iter()
+                        .map(|(k, _)| k.as_str())
+                        .filter(|k| !k.starts_with('<'))
+                        .collect();
+                    yaml::undefined(file, n, ("material", "materials", "materials"), name, known)
+                })
         }
         Some(n) => {
             let mut spec = ModuleSpec::from_node(file, n, "material", &[])?;

@@ -228,3 +228,28 @@ pub(crate) fn closest<'c>(word: &str, candidates: &[&'c str]) -> Option<&'c str>
         .min()
         .map(|(_, c)| c)
 }
+
+/// "undefined {what} `name`" at `node`, with the closest of `known` as a
+/// hint and all of them listed (`plural` defined under `section:`).
+pub(crate) fn undefined(
+    file: &Path,
+    node: &Node,
+    (what, plural, section): (&str, &str, &str),
+    name: &str,
+    mut known: Vec<&str>,
+) -> SceneError {
+    known.sort_unstable();
+    let hint = closest(name, &known)
+        .map(|s| format!(" (did you mean `{s}`?)"))
+        .unwrap_or_default();
+    let listed = if known.is_empty() {
+        "none".to_string()
+    } else {
+        known.join(", ")
+    };
+    SceneError::new(
+        file,
+        loc(node.span()),
+        format!("undefined {what} `{name}`{hint}; {plural} defined under `{section}:`: {listed}"),
+    )
+}

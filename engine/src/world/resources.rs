@@ -112,4 +112,6 @@ pub struct Scene {
     pub textures: Vec<(String, ModuleSpec)>,
     /// Materials (shaders), indexed by [`MaterialRef`](super::MaterialRef).
     pub materials: Vec<(String, ModuleSpec)>,
+    /// Participating media and the shapes' interfaces between them.
+    pub media: crate::scene::media::SceneMedia,
 }

@@ -36,6 +36,13 @@ bitflags! {
         /// and bump maps): hits orient their frames by the texture
         /// parametrisation and shaders receive the derivatives.
         const TANGENT_FRAMES = 1 << 10;
+        /// Participating media: paths sample distances in media and shadow
+        /// rays carry a transmittance (set by the engine where a shape or
+        /// the camera names a medium).
+        const MEDIA = 1 << 11;
+        /// An index-matched boundary (the `null` material) that rays pass
+        /// straight through, shadow rays included.
+        const NULL_INTERFACE = 1 << 12;
     }
 }
 

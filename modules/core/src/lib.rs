@@ -3,7 +3,7 @@
 //! Radiant's engine and its plugin modules meet in this crate. It defines
 //!
 //! * one trait per module kind — [`Camera`], [`Light`], [`Filter`], [`Shader`],
-//!   [`Sampler`], [`Texture`] — whose hot methods take *batches* (slices), so
+//!   [`Sampler`], [`Texture`], [`Medium`], [`Phase`] — whose hot methods take *batches* (slices), so
 //!   dynamic dispatch happens once per batch and the inner loops are plain code;
 //! * the [`Registry`] through which built-in and outside modules are made
 //!   known by their YAML `type` name, and [`Params`], the YAML parameters a
@@ -34,6 +34,7 @@ pub mod gpu;
 pub mod hash;
 pub mod input_file;
 pub mod light;
+pub mod medium;
 pub mod memory;
 pub mod params;
 pub mod registry;
@@ -51,6 +52,7 @@ pub use filter::{Filter, FilterSampler};
 pub use frame::Frame;
 pub use gpu::{GpuLibrary, GpuModule, GpuParams};
 pub use light::{EmitterEval, EmitterHit, Light, LightSample};
+pub use medium::{Coefficients, Medium, Phase};
 pub use params::{Color, Numbers, ParamError, Params, TextureInput};
 pub use registry::{ModuleInfo, ModuleKind, ParamDoc, Registry};
 pub use sampler::{SampleId, Sampler};

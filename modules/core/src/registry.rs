@@ -22,11 +22,14 @@
 //! assert!(registry.contains::<dyn Filter>("triangle"));
 //! ```
 
-use crate::{BuildContext, Camera, Filter, Light, ParamError, Params, Sampler, Shader, Texture};
+use crate::{
+    BuildContext, Camera, Filter, Light, Medium, ParamError, Params, Phase, Sampler, Shader,
+    Texture,
+};
 use std::collections::BTreeMap;
 use std::fmt;
 
-/// The six kinds of module.
+/// The eight kinds of module.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum ModuleKind {
     /// Generates primary rays.
@@ -41,6 +44,10 @@ pub enum ModuleKind {
     Sampler,
     /// Varies a value over a surface.
     Texture,
+    /// Fills space with an absorbing and scattering substance.
+    Medium,
+    /// Scatters light in a medium (a phase function).
+    Phase,
 }
 
 impl fmt::Display for ModuleKind {
@@ -52,6 +59,8 @@ impl fmt::Display for ModuleKind {
             ModuleKind::Shader => "shader",
             ModuleKind::Sampler => "sampler",
             ModuleKind::Texture => "texture",
+            ModuleKind::Medium => "medium",
+            ModuleKind::Phase => "phase",
         })
     }
 }
@@ -159,6 +168,8 @@ module_types! {
     Shader => Shader, shaders;
     Sampler => Sampler, samplers;
     Texture => Texture, textures;
+    Medium => Medium, media;
+    Phase => Phase, phases;
 }
 
 impl Registry {

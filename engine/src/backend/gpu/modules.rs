@@ -101,6 +101,15 @@ impl Modules {
                 .collect::<Vec<_>>()
                 .join(" or ")
         };
+        // Media have no WGSL yet: say so rather than render without them.
+        if scene.effects.contains(radiant_core::Effects::MEDIA) {
+            let name = scene.media.names.join(", ");
+            return Err(GpuError::MissingCode {
+                kind: "medium",
+                name,
+                type_name: type_of(radiant_core::ModuleKind::Medium),
+            });
+        }
         // Camera and sampler: one instance each.
         let camera = scene.camera.gpu().ok_or_else(|| GpuError::MissingCode {
             kind: "camera",
