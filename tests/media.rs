@@ -259,6 +259,74 @@ fn medium_furnace_returns_the_environment() {
     assert!(centre.max_element() < 0.9, "the sphere's centre {centre}");
 }
 
+/// The mean and the largest channel value of an image.
+fn mean_and_max(image: &Image) -> (f64, f32) {
+    let n = image.pixels.len() as f64;
+    let mean = image
+        .pixels
+        .iter()
+        .map(|p| f64::from(p.element_sum()) / 3.0)
+        .sum::<f64>()
+        / n;
+    let max = image
+        .pixels
+        .iter()
+        .map(|p| p.max_element())
+        .fold(0.0f32, f32::max);
+    (mean, max)
+}
+
+#[test]
+fn torture_media_are_finite_terminate_and_keep_their_energy() {
+    // Optically very thick (density 1e4, albedo 0.5): paths end by
+    // absorption and roulette; finite, never above the environment, and
+    // the sphere is dark (it absorbs half at every one of its many
+    // scatterings).
+    let thick = render_text(
+        &furnace("{type: homogeneous, albedo: 0.5, density: 1e4}"),
+        Overrides::default(),
+    );
+    assert_eq!(thick.invalid_samples, 0);
+    let (_, max) = mean_and_max(&thick.image);
+    assert!(max < 1.05, "thick medium: a pixel at {max}");
+    assert!(thick.image.pixels[8 * 16 + 8].max_element() < 0.5);
+    // Nearly vacuum (density 1e-6): the image is the empty scene's, the
+    // environment's radiance 1 everywhere.
+    let thin = render_text(
+        &furnace("{type: homogeneous, albedo: 0.5, density: 1e-6}"),
+        Overrides::default(),
+    );
+    for p in &thin.image.pixels {
+        assert!(
+            (*p - Rgb::ONE).abs().max_element() < 1e-3,
+            "thin medium: pixel {p}"
+        );
+    }
+    // g = ±0.999 (nearly a delta lobe either way), albedo 1: the furnace
+    // still returns the environment.
+    for g in ["0.999", "-0.999"] {
+        let r = render_text(
+            &furnace(&format!(
+                "{{type: homogeneous, albedo: 1, density: 2, phase: {{type: hg, g: {g}}}}}"
+            )),
+            Overrides::default(),
+        );
+        assert_eq!(r.invalid_samples, 0);
+        let (mean, _) = mean_and_max(&r.image);
+        assert!((mean - 1.0).abs() < 0.01, "g = {g}: mean {mean}");
+    }
+    // The camera inside the medium (`camera: {medium: m}`), looking out
+    // through the boundary: still the environment.
+    let inside = furnace("{type: homogeneous, albedo: 1, density: 1.5}").replace(
+        "camera: {type: perspective, fov: 40, look_at: {origin: [0, 0, 4],",
+        "camera: {type: perspective, fov: 40, medium: m, look_at: {origin: [0, 0, 0.5],",
+    );
+    assert!(inside.contains("medium: m"));
+    let r = render_text(&inside, Overrides::default());
+    let (mean, _) = mean_and_max(&r.image);
+    assert!((mean - 1.0).abs() < 0.01, "camera inside: mean {mean}");
+}
+
 // --- Against Mitsuba 3 `volpath` -------------------------------------------
 
 const SPP: u32 = 256;
@@ -409,4 +477,25 @@ fn bad_media_are_located_errors() {
             "{text}\n→ {e} (expected line {line})"
         );
     }
+}
+
+#[test]
+fn a_medium_in_an_open_mesh_is_a_located_error() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let obj = dir.path().join("open.obj");
+    // Two triangles of a square: every outer edge has one side only.
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n",
+    )
+    .expect("the temporary folder is writable");
+    let text = format!(
+        "camera: {{type: perspective}}\n\
+         media:\n  fog: {{type: homogeneous}}\n\
+         shapes:\n  - {{type: mesh, filename: {}, interior: fog}}\n",
+        obj.display()
+    );
+    let e = load_error(&text);
+    assert!(e.contains("closed shape") && e.contains("4 edges"), "{e}");
+    assert!(e.contains("bad.yaml:5:"), "{e}");
 }

@@ -96,7 +96,9 @@ pub fn back_facing(scene: &RenderScene) -> Vec<BackFacing> {
     seen.iter()
         .enumerate()
         .filter(|&(m, &(front, back))| {
-            let two_sided = scene.shaders[m].effects().contains(Effects::TRANSMISSION);
+            let two_sided = scene.shaders[m]
+                .effects()
+                .intersects(Effects::TRANSMISSION | Effects::NULL_INTERFACE);
             !two_sided && back > front && back as f32 >= MIN_SHARE * rays
         })
         .map(|(m, &(front, back))| BackFacing {

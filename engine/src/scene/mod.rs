@@ -23,6 +23,7 @@
 //! Every error names the file, line and column, what was expected and what
 //! is allowed. Relative paths are resolved against the scene file's folder.
 
+pub mod docs;
 mod gltf;
 mod instances;
 mod keyframes;
