@@ -24,6 +24,7 @@
 //! is allowed. Relative paths are resolved against the scene file's folder.
 
 pub mod docs;
+pub mod docs;
 mod gltf;
 mod instances;
 mod keyframes;
