@@ -200,19 +200,20 @@ fn broken_ply_files_are_located_errors() {
 }
 
 /// The glTF scene's contents written in Radiant's YAML: the camera, the
-/// light, the torus placed by the two nodes' transforms (parent
-/// translation, child rotation and scale) and its material.
+/// lights (the spot and the sun shining along their nodes' turned −z), the
+/// torus placed by the two nodes' transforms (parent translation, child
+/// rotation and scale) and its material.
 const GLTF_AS_YAML: &str = "\
 camera: {type: perspective, fov: 30, fov_axis: y, look_at: {origin: [0, 0, 6], target: [0, 0, 0], up: [0, 1, 0]}}
 textures: {checks: {type: image, filename: checks.png}}
 materials: {torus: {type: principled, base_color: checks, metallic: 0.3, roughness: 0.6}}
 shapes:
-  - {type: mesh, filename: torus-uv.obj, material: torus, transform: [TRANSFORM]}
+  - {type: mesh, filename: torus-uv.obj, material: torus, transform: [{translate: [0.3, -0.2, 0]}, {rotate: {axis: [1, 0, 0], angle: 90}}, {scale: 0.8}]}
 lights:
   - {type: point, position: [3, 3, 2], intensity: [25, 22.5, 20]}
+  - {type: spot, position: [-1, 2, 4], direction: [0, -0.5, -0.8660254037844387], intensity: [20, 20, 40], cutoff_angle: 28.64788975654116, beam_width: 17.188733853924695}
+  - {type: directional, direction: [-0.7071067811865475, 0, -0.7071067811865475], irradiance: 0.5}
 ";
-const TRANSFORM: &str =
-    "{translate: [0.3, -0.2, 0]}, {rotate: {axis: [1, 0, 0], angle: 90}}, {scale: 0.8}";
 
 /// What both glTF comparisons render: a dim environment (glTF has none).
 const SETTINGS: &str = "\
@@ -253,54 +254,53 @@ fn relative_difference(a: &Image, b: &Image) -> f64 {
 const SAME_SCENE: f64 = 0.001;
 
 #[test]
-fn gltf_nodes_material_texture_camera_and_light_are_imported() {
+fn gltf_nodes_material_texture_camera_and_lights_are_imported() {
     let gltf = render_text(
         "camera: {type: gltf, filename: scene.gltf}\nshapes:\n  - {type: gltf, filename: scene.gltf}\nlights:\n",
     )
     .expect("the glTF scene renders");
-    let yaml = |transform: &str, metallic: &str| {
-        render_text(
-            &GLTF_AS_YAML
-                .replace("TRANSFORM", transform)
-                .replace("metallic: 0.3", metallic),
-        )
-        .expect("the YAML twin renders")
+    let yaml = |from: &str, to: &str| {
+        assert!(GLTF_AS_YAML.contains(from), "{from}");
+        render_text(&GLTF_AS_YAML.replace(from, to)).expect("the YAML twin renders")
     };
-    let same = relative_difference(&gltf, &yaml(TRANSFORM, "metallic: 0.3"));
+    let same = relative_difference(&gltf, &yaml("", ""));
     eprintln!("glTF against YAML: {same:.2e}");
     assert!(
         same < SAME_SCENE,
         "the glTF scene differs from its YAML twin: {same}"
     );
-    // The comparison's power: without the parent's translation, without
-    // the child's rotation, or with another metalness, the images differ.
+    // The comparison's power: without the parent's translation or the
+    // child's rotation, with another metalness, or with a light turned
+    // or left out, the images differ.
     let wrong = [
+        ("{translate: [0.3, -0.2, 0]}, ", ""),
+        ("{rotate: {axis: [1, 0, 0], angle: 90}}, ", ""),
+        ("metallic: 0.3", "metallic: 0.9"),
+        ("direction: [0, -0.5,", "direction: [0, 0.5,"),
         (
-            "{rotate: {axis: [1, 0, 0], angle: 90}}, {scale: 0.8}",
-            "metallic: 0.3",
+            "direction: [-0.7071067811865475,",
+            "direction: [0.7071067811865475,",
         ),
-        ("{translate: [0.3, -0.2, 0]}, {scale: 0.8}", "metallic: 0.3"),
-        (TRANSFORM, "metallic: 0.9"),
+        (POINT_LIGHT_LINE, ""),
     ];
-    for (transform, metallic) in wrong {
-        let d = relative_difference(&gltf, &yaml(transform, metallic));
-        eprintln!("{transform}, {metallic}: {d:.5}");
-        assert!(d > 5.0 * SAME_SCENE, "{transform}, {metallic}: only {d}");
+    for (from, to) in wrong {
+        let d = relative_difference(&gltf, &yaml(from, to));
+        eprintln!("`{from}` → `{to}`: {d:.5}");
+        assert!(d > 5.0 * SAME_SCENE, "`{from}` → `{to}`: only {d}");
     }
-    // With `lights: false` the glTF's light stays out: the image is the
-    // YAML twin's without its point light.
+    // With `lights: false` the glTF's lights stay out: the image is the
+    // YAML twin's without them.
     let unlit = render_text(
         "camera: {type: gltf, filename: scene.gltf}\nshapes:\n  - {type: gltf, filename: scene.gltf, lights: false}\nlights:\n",
     )
     .expect("the glTF scene renders");
-    let twin = GLTF_AS_YAML.replace(POINT_LIGHT_LINE, "");
-    let twin = render_text(&twin.replace("TRANSFORM", TRANSFORM)).expect("the YAML twin renders");
+    let lights = GLTF_AS_YAML.find("lights:\n").expect("a light list") + "lights:\n".len();
+    let twin = render_text(&GLTF_AS_YAML[..lights]).expect("the YAML twin renders");
     let d = relative_difference(&unlit, &twin);
     assert!(
         d < SAME_SCENE,
-        "lights: false differs from the scene without the light: {d}"
+        "lights: false differs from the scene without the lights: {d}"
     );
-    assert!(relative_difference(&unlit, &gltf) > 5.0 * SAME_SCENE);
 }
 
 const POINT_LIGHT_LINE: &str =
@@ -393,4 +393,63 @@ fn broken_gltf_files_are_located_errors() {
             "expected `{expected}` in: {message}"
         );
     }
+}
+
+/// A deforming mesh without normals (an OBJ per frame, as a simulation
+/// writes them) gets at every frame the smooth normals of that frame's
+/// positions: frame 4 reached through frames 1 to 3 renders as frame 4's
+/// file loaded as a still mesh, and not as that file with flat normals.
+#[test]
+fn a_deforming_mesh_gets_the_smooth_normals_of_each_frame() {
+    use radiant::backend::cpu::{Progress, render};
+    use radiant::extract::{Sequence, SequenceOptions};
+    let dir = tempfile::tempdir().expect("temporary folders can be made");
+    for f in 1..=4 {
+        let path = dir.path().join(format!("wave_{f:03}.obj"));
+        radiant_tests::write_grid(&path, 12, f as f32 * 0.9, false);
+    }
+    let scene = |filename: &str, frames: &str| {
+        format!(
+            "animation: {{fps: 24, frames: {frames}}}\nfilm: {{width: 48, height: 48}}\n\
+             sampler: {{type: independent, spp: 8}}\n\
+             camera: {{type: perspective, look_at: {{origin: [0, -2, 3], target: [0, 0, 0]}}}}\n\
+             shapes:\n  - {{type: mesh, filename: {filename}, material: {{type: diffuse, reflectance: 0.8}}}}\n\
+             lights:\n  - {{type: point, position: [1, -1, 2], intensity: 5}}\n"
+        )
+    };
+    let registry = radiant::builtin_registry();
+    let load = |text: &str| {
+        radiant::scene::from_str(text, Path::new("wave.yaml"), dir.path())
+            .expect("the scene parses")
+    };
+    let mut animated = load(&scene("wave_###.obj", "[1, 4]"));
+    // Locked noise: every frame draws the samples of a still render.
+    let options = SequenceOptions {
+        lock_noise: true,
+        ..SequenceOptions::default()
+    };
+    let (mut s, _) = Sequence::new(&mut animated, &registry, &Overrides::default(), &options, 1)
+        .expect("the first frame builds");
+    for f in 2..=4 {
+        s.go_to(&mut animated, &registry, f)
+            .expect("the frame updates");
+    }
+    let frame4 = render(s.scene(), &Progress::none()).image;
+    let still = |filename: &str| {
+        let scene = load(&scene(filename, "[1, 1]"));
+        let r = radiant::extract::extract(&scene, &registry, &Overrides::default())
+            .expect("the scene extracts");
+        render(&r, &Progress::none()).image
+    };
+    let smooth = relative_difference(&frame4, &still("wave_004.obj"));
+    let flat = relative_difference(&frame4, &still("wave_004.obj, face_normals: true"));
+    let first = relative_difference(&frame4, &still("wave_001.obj"));
+    eprintln!(
+        "frame 4 against its file: smooth {smooth:.2e}, flat {flat:.2e}, frame 1 {first:.2e}"
+    );
+    assert!(
+        smooth < SAME_SCENE,
+        "frame 4 differs from its file: {smooth}"
+    );
+    assert!(flat > 5.0 * SAME_SCENE && first > 5.0 * SAME_SCENE);
 }

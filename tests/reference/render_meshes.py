@@ -18,7 +18,8 @@ Writes into ``tests/data/meshes/``:
    torus: a parent node that translates and a child that turns and scales
    it, a metallic-roughness material with a base-colour texture (the
    8 x 8 checkerboard ``checks.png``), a perspective camera and a
-   ``KHR_lights_punctual`` point light, each on a node of its own; the test
+   ``KHR_lights_punctual`` point, spot and directional light, each on a
+   node of its own (the spot and the sun turned); the test
    renders it against the same scene written in Radiant's YAML.
 5. ``smooth.yaml`` (the torus, diffuse, lit by a point light and a dim
    environment) and its Mitsuba render ``smooth-mitsuba.exr``, where
@@ -179,13 +180,23 @@ def write_scene_gltf(path, mesh_path):
     half = math.sqrt(0.5)
     doc["extensionsUsed"] = ["KHR_lights_punctual"]
     doc["extensions"] = {"KHR_lights_punctual": {"lights": [
-        {"type": "point", "color": [1.0, 0.9, 0.8], "intensity": 25.0, "name": "lamp"}]}}
-    doc["scenes"] = [{"nodes": [0, 2, 3]}]
+        {"type": "point", "color": [1.0, 0.9, 0.8], "intensity": 25.0, "name": "lamp"},
+        {"type": "spot", "color": [0.5, 0.5, 1.0], "intensity": 40.0, "name": "spot",
+         "spot": {"innerConeAngle": 0.3, "outerConeAngle": 0.5}},
+        {"type": "directional", "color": [1.0, 1.0, 1.0], "intensity": 0.5, "name": "sun"}]}}
+    doc["scenes"] = [{"nodes": [0, 2, 3, 4, 5]}]
+    # The spot turns -30 degrees about x (it shines along (0, -sin 30, -cos 30)),
+    # the sun 45 degrees about y (it shines along (-sin 45, 0, -cos 45)).
+    spot = [math.sin(math.radians(-15)), 0.0, 0.0, math.cos(math.radians(-15))]
+    sun = [0.0, math.sin(math.radians(22.5)), 0.0, math.cos(math.radians(22.5))]
     doc["nodes"] = [
         {"name": "root", "translation": [0.3, -0.2, 0.0], "children": [1]},
         {"name": "torus", "mesh": 0, "rotation": [half, 0.0, 0.0, half], "scale": [0.8, 0.8, 0.8]},
         {"name": "camera", "camera": 0, "translation": [0.0, 0.0, 6.0]},
         {"name": "lamp", "translation": [3.0, 3.0, 2.0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+        {"name": "spot", "translation": [-1.0, 2.0, 4.0], "rotation": spot,
+         "extensions": {"KHR_lights_punctual": {"light": 1}}},
+        {"name": "sun", "rotation": sun, "extensions": {"KHR_lights_punctual": {"light": 2}}},
     ]
     doc["cameras"] = [{"type": "perspective", "perspective": {"yfov": math.radians(30), "znear": 0.01}}]
     doc["meshes"][0]["primitives"][0]["material"] = 0

@@ -24,7 +24,6 @@
 //! is allowed. Relative paths are resolved against the scene file's folder.
 
 pub mod docs;
-pub mod docs;
 mod gltf;
 mod instances;
 mod keyframes;
