@@ -13,10 +13,12 @@ use super::reference::Reference;
 use super::twin::{TwinImages, TwinRender};
 use crate::accel::BuildQuality;
 use crate::extract::{Overrides, RenderScene, extract};
+use crate::film::denoise::Denoiser;
 use crate::scene::{FilterSampling, LightSelection, Scene, default_module};
 use crate::world::{EmitterSpec, LightSpec};
 use radiant_core::{Filter, Registry, Sampler};
 use std::fmt;
+use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 /// One thing a sweep varies.
@@ -41,11 +43,14 @@ pub enum Axis {
     /// The backend: the scene on the GPU (where a hardware adapter is
     /// present) against the CPU baseline.
     Backend,
+    /// Open Image Denoise on each half (off, on; where the library
+    /// loads): what denoising buys at each time, and where it biases.
+    Denoise,
 }
 
 impl Axis {
     /// Every axis, in report order.
-    pub const ALL: [Axis; 9] = [
+    pub const ALL: [Axis; 10] = [
         Axis::Spp,
         Axis::MaxDepth,
         Axis::RrDepth,
@@ -55,6 +60,7 @@ impl Axis {
         Axis::LightSelection,
         Axis::Bvh,
         Axis::Backend,
+        Axis::Denoise,
     ];
 
     /// The name used on the command line and in the CSV.
@@ -69,6 +75,7 @@ impl Axis {
             Axis::LightSelection => "light_selection",
             Axis::Bvh => "bvh",
             Axis::Backend => "backend",
+            Axis::Denoise => "denoise",
         }
     }
 
@@ -105,6 +112,9 @@ pub enum Change {
     Bvh(BuildQuality),
     /// Rendered by the GPU backend.
     Gpu,
+    /// Denoised (with `filter_sampling: importance`, as `--denoise`
+    /// renders).
+    Denoise,
 }
 
 /// One setting of the sweep.
@@ -138,6 +148,7 @@ impl Setting {
             Change::LightSelection(LightSelection::Uniform) => "uniform".into(),
             Change::Bvh(q) => format!("{q:?}").to_lowercase(),
             Change::Gpu => "gpu".into(),
+            Change::Denoise => "on".into(),
         }
     }
 
@@ -163,6 +174,7 @@ impl Setting {
             Change::FilterSampling(f) => overrides.filter_sampling = Some(*f),
             Change::LightSelection(l) => overrides.light_selection = Some(*l),
             Change::Bvh(q) => overrides.bvh = Some(*q),
+            Change::Denoise => overrides.filter_sampling = Some(FilterSampling::Importance),
             _ => {}
         }
         let (filter, sampler) = (scene.filter.clone(), scene.sampler.clone());
@@ -241,6 +253,13 @@ pub fn settings(scene: &Scene, registry: &Registry, axes: &[Axis]) -> (Vec<Setti
                     continue;
                 }
             },
+            Axis::Denoise => match shared_denoiser() {
+                Ok(_) => vec![Change::Denoise],
+                Err(why) => {
+                    notes.push(format!("denoise: not measured: {why}"));
+                    continue;
+                }
+            },
         };
         if changes.is_empty() {
             notes.push(format!("{axis}: only the scene's own value is registered"));
@@ -248,6 +267,16 @@ pub fn settings(scene: &Scene, registry: &Registry, axes: &[Axis]) -> (Vec<Setti
         list.extend(changes.into_iter().map(|change| Setting { axis, change }));
     }
     (list, notes)
+}
+
+/// Open Image Denoise for the `denoise` axis, loaded once per process;
+/// why it cannot be loaded otherwise.
+fn shared_denoiser() -> Result<&'static Denoiser, String> {
+    static DENOISER: OnceLock<Result<Denoiser, String>> = OnceLock::new();
+    DENOISER
+        .get_or_init(|| Denoiser::load().map_err(|e| e.to_string()))
+        .as_ref()
+        .map_err(Clone::clone)
 }
 
 /// One point of a setting's error curve.
@@ -317,7 +346,12 @@ pub fn measure(
         }
         _ => None,
     };
-    let mut twin = TwinRender::new(scene, registry, render, limits.seed + 1)?.on_gpu(gpu);
+    let denoiser = (setting.change == Change::Denoise).then(|| {
+        shared_denoiser().expect("the denoise axis has settings only where the library loaded")
+    });
+    let mut twin = TwinRender::new(scene, registry, render, limits.seed + 1)?
+        .on_gpu(gpu)
+        .denoised_by(denoiser)?;
     let mut points = Vec::new();
     twin.run_doubling(max_half, start, limits.share, |twin| {
         let images = TwinImages::of(twin);
@@ -380,7 +414,12 @@ mod tests {
         let mut registry = crate::builtin_registry();
         let one = scene("{type: path, max_depth: 5, rr_depth: 2}", POINT);
         let (list, notes) = settings(&one, &registry, &Axis::ALL);
-        let labels: Vec<String> = list.iter().map(Setting::label).collect();
+        let mut labels: Vec<String> = list.iter().map(Setting::label).collect();
+        // The denoise axis is there where the library loads, else a note.
+        let denoise = labels.last().is_some_and(|l| l == "denoise=on");
+        assert_eq!(denoise, shared_denoiser().is_ok());
+        assert_eq!(!denoise, notes.iter().any(|n| n.starts_with("denoise")));
+        labels.truncate(labels.len() - usize::from(denoise));
         assert_eq!(
             labels,
             [

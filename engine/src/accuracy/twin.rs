@@ -1,16 +1,20 @@
 //! Two independent progressive renders of one setting, with two sampler
 //! seeds, over one extracted scene: the halves whose difference measures
-//! the noise (see [`metrics`](super::metrics)).
+//! the noise (see [`metrics`](super::metrics)). On the `denoise` axis each
+//! half also collects its first-hit planes and is denoised when developed.
 
 use super::metrics::Halves;
-use crate::backend::cpu::{Progress, render_samples};
+use crate::backend::cpu::{Progress, render_samples, render_samples_with_aovs};
 use crate::backend::gpu::{GpuBackend, GpuError};
 use crate::error::{SceneError, module_error};
 use crate::extract::RenderScene;
+use crate::film::aov::AovFilm;
+use crate::film::denoise::{Denoiser, Guides};
 use crate::film::{Film, Image};
 use crate::scene::Scene;
 use glam::UVec2;
 use radiant_core::{BuildContext, Registry, Sampler, TextureTable};
+use std::cell::Cell;
 use std::collections::HashMap;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -28,6 +32,10 @@ pub struct TwinRender {
     gpu: Option<&'static Mutex<GpuBackend>>,
     /// The GPU's first failure; rendering stops there.
     error: Option<GpuError>,
+    /// The denoiser of the `denoise` axis, with each half's planes.
+    denoise: Option<(&'static Denoiser, [AovFilm; 2])>,
+    /// Time spent denoising so far (developing happens behind `&self`).
+    denoise_time: Cell<Duration>,
 }
 
 /// Builds `scene`'s sampler for `seed` the way extract does (samplers use
@@ -73,6 +81,29 @@ impl TwinRender {
             time: Duration::ZERO,
             gpu: None,
             error: None,
+            denoise: None,
+            denoise_time: Cell::new(Duration::ZERO),
+        })
+    }
+
+    /// The same renders, each half denoised by `denoiser` where it is
+    /// given (its planes rendered along, on the CPU).
+    pub fn denoised_by(
+        self,
+        denoiser: Option<&'static Denoiser>,
+    ) -> Result<Self, super::AccuracyError> {
+        let Some(denoiser) = denoiser else {
+            return Ok(self);
+        };
+        let (w, h) = (self.scene.settings.width, self.scene.settings.height);
+        let whole = |e| super::AccuracyError::WholeFilm(Box::new(e));
+        let planes = [
+            AovFilm::try_new(w, h).map_err(whole)?,
+            AovFilm::try_new(w, h).map_err(whole)?,
+        ];
+        Ok(Self {
+            denoise: Some((denoiser, planes)),
+            ..self
         })
     }
 
@@ -91,9 +122,9 @@ impl TwinRender {
         self.spp
     }
 
-    /// Render time so far (both halves).
+    /// Render time so far (both halves), denoising included.
     pub fn time(&self) -> Duration {
-        self.time
+        self.time + self.denoise_time.get()
     }
 
     /// Renders both halves on to `spp` samples per pixel each; returns the
@@ -101,13 +132,18 @@ impl TwinRender {
     pub fn advance(&mut self, spp: u32) -> Duration {
         let mut took = Duration::ZERO;
         if spp > self.spp && self.error.is_none() {
-            for film in &mut self.films {
+            for (half, film) in self.films.iter_mut().enumerate() {
                 let range = self.spp..spp;
-                took += match self.gpu {
-                    None => render_samples(&self.scene, film, range, &Progress::none()).time,
-                    Some(gpu) => {
+                let none = Progress::none();
+                took += match (self.gpu, &mut self.denoise) {
+                    (None, Some((_, planes))) => {
+                        render_samples_with_aovs(&self.scene, film, &mut planes[half], range, &none)
+                            .time
+                    }
+                    (None, None) => render_samples(&self.scene, film, range, &none).time,
+                    (Some(gpu), _) => {
                         let mut gpu = gpu.lock().unwrap_or_else(|e| e.into_inner());
-                        match gpu.render_samples(&self.scene, film, range, &Progress::none()) {
+                        match gpu.render_samples(&self.scene, film, range, &none) {
                             Ok(pass) => pass.time,
                             Err(e) => {
                                 self.error.get_or_insert(e);
@@ -165,9 +201,24 @@ impl TwinRender {
         }
     }
 
-    /// The two halves developed.
+    /// The two halves developed (and denoised, on the `denoise` axis;
+    /// a half the denoiser fails on stays as it is).
     pub fn images(&self) -> [Image; 2] {
-        [self.films[0].develop(), self.films[1].develop()]
+        let images = [self.films[0].develop(), self.films[1].develop()];
+        let Some((denoiser, planes)) = &self.denoise else {
+            return images;
+        };
+        let start = Instant::now();
+        let guides = Guides::of(&self.scene);
+        let [a, b] = images;
+        let denoised = [(a, &planes[0]), (b, &planes[1])].map(|(image, planes)| {
+            denoiser
+                .denoise(&image, &planes.develop(), guides)
+                .unwrap_or(image)
+        });
+        self.denoise_time
+            .set(self.denoise_time.get() + start.elapsed());
+        denoised
     }
 
     /// Samples that were NaN or infinite (recorded as black), both halves.

@@ -30,8 +30,8 @@ pub struct AccuracyArgs {
     out: PathBuf,
     /// Sweep only these axes, comma-separated: spp, max_depth, rr_depth,
     /// filter, filter_sampling, sampler, light_selection, bvh, backend (the
-    /// GPU, where a hardware adapter is present; the scene as written is
-    /// always measured).
+    /// GPU, where a hardware adapter is present), denoise (Open Image
+    /// Denoise, where it loads); the scene as written is always measured.
     #[arg(long, value_delimiter = ',')]
     only: Vec<String>,
     /// Largest samples per pixel of a setting.

@@ -208,6 +208,19 @@ fn surface_batch<'a>(
     }
 }
 
+/// Each shader with the range of live paths (material order, as
+/// [`sort_by_key`] leaves them with `offsets`) that it shades, where that
+/// range is not empty.
+fn material_ranges<'a>(
+    shaders: &'a [Box<dyn Shader>],
+    offsets: &'a [u32],
+) -> impl Iterator<Item = (&'a dyn Shader, std::ops::Range<usize>)> + 'a {
+    shaders.iter().enumerate().filter_map(|(m, shader)| {
+        let (a, b) = (offsets[m] as usize, offsets[m + 1] as usize);
+        (a < b).then(|| (shader.as_ref(), a..b))
+    })
+}
+
 impl Wavefront {
     /// Renders `batch` and adds its samples to `tile`.
     pub fn render(
@@ -646,17 +659,9 @@ impl Wavefront {
     fn record_first_hits(&mut self, scene: &RenderScene, n: usize) {
         fit(&mut self.albedo_k, n);
         let mut ctx = ShadeContext::new(&scene.textures);
-        for (m, shader) in scene.shaders.iter().enumerate() {
-            let (a, b) = (self.offsets[m] as usize, self.offsets[m + 1] as usize);
-            if a == b {
-                continue;
-            }
-            let surface = surface_batch(
-                shader.as_ref(),
-                [&self.wo, &self.dp_du, &self.dp_dv],
-                &self.uv,
-                a..b,
-            );
+        for (shader, k) in material_ranges(&scene.shaders, &self.offsets) {
+            let (a, b) = (k.start, k.end);
+            let surface = surface_batch(shader, [&self.wo, &self.dp_du, &self.dp_dv], &self.uv, k);
             shader.albedo(&mut ctx, surface, &mut self.albedo_k[a..b]);
         }
         let (its, origin) = (&self.its[..], &self.origin[..]);
@@ -769,17 +774,9 @@ impl Wavefront {
         fit(&mut self.nee_eval, n);
         let mut ctx = ShadeContext::new(&scene.textures);
         let has_lights = !scene.lights.is_empty();
-        for (m, shader) in scene.shaders.iter().enumerate() {
-            let (a, b) = (self.offsets[m] as usize, self.offsets[m + 1] as usize);
-            if a == b {
-                continue;
-            }
-            let surface = surface_batch(
-                shader.as_ref(),
-                [&self.wo, &self.dp_du, &self.dp_dv],
-                &self.uv,
-                a..b,
-            );
+        for (shader, k) in material_ranges(&scene.shaders, &self.offsets) {
+            let (a, b) = (k.start, k.end);
+            let surface = surface_batch(shader, [&self.wo, &self.dp_du, &self.dp_dv], &self.uv, k);
             shader.sample(&mut ctx, surface, &self.u3[a..b], &mut self.bsdf[a..b]);
             if has_lights && shader.effects().contains(Effects::SMOOTH_LOBES) {
                 shader.eval(
