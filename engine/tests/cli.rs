@@ -754,7 +754,8 @@ fn a_frame_larger_than_memory_renders_in_bands() {
 fn a_band_larger_than_memory_is_a_clear_error() {
     // A band of a 32768-pixel-wide frame (one tile row with the filter's
     // border, the rows on their way to the file, a group of tiles and the
-    // encoder's blocks) needs about 75 MB, more than a 60 MB
+    // encoder's blocks) needs about 160 MB (the film's and the tiles' exact
+    // sums take 64 bytes a pixel), more than a 60 MB
     // address-space limit leaves after the program itself (about 30 MB
     // with two threads).
     let (dir, out) = temp("huge.exr");
@@ -788,8 +789,9 @@ fn a_band_larger_than_memory_is_a_clear_error() {
 
 #[test]
 fn a_whole_film_larger_than_memory_is_a_clear_error() {
-    // The accuracy report keeps whole films: 8192² pixels need 1.75 GiB,
-    // more than a 1.2 GB address-space limit allows.
+    // The accuracy report keeps whole films: 8192² pixels need 4.75 GiB
+    // (64 bytes of exact sums and 12 of image a pixel), more than a 1.2 GB
+    // address-space limit allows.
     let (dir, report) = temp("report");
     let args = [
         "--width", "8192", "--height", "8192", "--budget", "1", "--out",
@@ -808,7 +810,7 @@ fn a_whole_film_larger_than_memory_is_a_clear_error() {
         "{err}"
     );
     assert!(
-        err.contains("a 8192×8192 frame needs 1.75 GiB of memory"),
+        err.contains("a 8192×8192 frame needs 4.75 GiB of memory"),
         "{err}"
     );
     assert!(err.contains("rows at this width"), "{err}");

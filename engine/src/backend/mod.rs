@@ -2,10 +2,12 @@
 //! tracer on every core through rayon; [`gpu`] runs it as a wgpu compute
 //! kernel assembled from the frame's modules. [`Backend`] is the seam the
 //! command line renders through, and [`choose`] picks one as
-//! `--backend cpu|gpu|auto` asks.
+//! `--backend cpu|gpu|auto` asks; [`progressive`] renders through it in
+//! passes (`--time`, `--checkpoint`, `--resume`).
 
 pub mod cpu;
 pub mod gpu;
+pub mod progressive;
 
 use crate::extract::RenderScene;
 use crate::film::memory::FrameTooLarge;

@@ -3,6 +3,7 @@
 
 mod partition;
 mod passes;
+mod progressive;
 
 use super::diagnostic::report;
 use super::film_args::FilmArgs;
@@ -76,6 +77,8 @@ pub struct RenderArgs {
     /// (`3/16`) into a partial EXR file for `radiant merge`.
     #[arg(long, value_parser = clap::value_parser!(radiant::farm::partition::Partition))]
     partition: Option<radiant::farm::partition::Partition>,
+    #[command(flatten)]
+    progressive: progressive::ProgressiveArgs,
     #[command(flatten)]
     film: FilmArgs,
     #[command(flatten)]
@@ -202,6 +205,7 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
     if let Some(p) = args.partition {
         return partition::run(registry, args, p);
     }
+    let progressive = progressive::start(args)?;
     let pattern = args.output.to_string_lossy().contains('#');
     check_output(&frame_path(&args.output, 0))?;
     let mut scene = radiant::scene::load(&args.scene).map_err(report)?;
@@ -297,7 +301,10 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         let path = frame_path(&args.output, frame);
         let rendered = pool.install(|| {
             let progress = Progress::new(&progress);
-            if args.passes.wanted() {
+            if let Some(session) = &progressive {
+                let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
+                session.render(args, backend.as_mut(), (s, frame), &path, &progress, &note)
+            } else if args.passes.wanted() {
                 let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
                 passes::write(&args.passes, s, &path, &progress, &note)
             } else {
@@ -319,7 +326,7 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
             "rendered {}x{}, {} spp in {:.3} s ({:.2} Msamples/s, {:.2} Mrays/s)",
             settings.width,
             settings.height,
-            settings.spp,
+            rendered.samples / (settings.width as u64 * settings.height as u64).max(1),
             secs,
             rendered.samples as f64 / secs / 1e6,
             rendered.rays as f64 / secs / 1e6
@@ -345,6 +352,10 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         totals.update += update.update;
         totals.bvh += update.bvh;
         totals.render += rendered.time;
+        if progressive.as_ref().is_some_and(|p| p.interrupted()) {
+            bar.finish_and_clear();
+            std::process::exit(progressive::INTERRUPTED.into());
+        }
     }
     if let Some(bar) = bar {
         bar.finish_and_clear();

@@ -2,7 +2,9 @@
 //! ([`partial`](super::partial) files) into the frame. The files must be
 //! parts of one render (same scene, size, frame, samples per pixel, seed
 //! and depth) whose sample ranges cover the frame's samples exactly once;
-//! they are added in the order of their samples.
+//! they are added in the order of their samples. The sums are exact
+//! ([`Sums`](crate::film::exact::Sums)), so the merged frame is the one
+//! render of all the samples would have made, bit for bit.
 
 use super::partial::{self, Header, PartialError};
 use crate::film::Film;
@@ -54,6 +56,18 @@ pub enum MergeError {
         /// Which files lie around the gap.
         context: String,
     },
+    /// A file is a progressive render's state, not a partition.
+    #[error(
+        "`{path}` is a progressive render's state (samples 0..{samples} of {spp}), not a sample partition: continue it with `radiant render --resume {path}`"
+    )]
+    Progressive {
+        /// The file.
+        path: PathBuf,
+        /// Samples it holds.
+        samples: u32,
+        /// The samples per pixel it renders at most.
+        spp: u32,
+    },
     /// A file could not be read, or is not a partition.
     #[error(transparent)]
     Partial(#[from] PartialError),
@@ -76,7 +90,7 @@ pub fn merge(files: &[PathBuf]) -> Result<(Film, Header), MergeError> {
     let mut film = Film::try_new(first.width, first.height)?;
     for &i in &order {
         let part = partial::read(&headers[i].0)?;
-        film.add_layers(&part.sums, part.header.invalid_samples);
+        film.add_sums(&part.sums, part.header.invalid_samples);
     }
     Ok((film, first.clone()))
 }
@@ -87,6 +101,13 @@ pub fn order(parts: &[(PathBuf, Header)]) -> Result<Vec<usize>, MergeError> {
     let Some((first_path, first)) = parts.first() else {
         return Err(MergeError::Empty);
     };
+    if let Some((path, header)) = parts.iter().find(|(_, h)| h.partition.is_none()) {
+        return Err(MergeError::Progressive {
+            path: path.clone(),
+            samples: header.samples.end,
+            spp: header.spp,
+        });
+    }
     let identity = first.identity();
     for (path, header) in &parts[1..] {
         for ((what, a, a_shown), (_, b, b_shown)) in identity.iter().zip(header.identity()) {
@@ -154,7 +175,7 @@ mod tests {
     use crate::farm::partial::tests::header;
     use crate::farm::partition::Partition;
 
-    /// Partition `index`/4 of a 3×2 film of 8 spp, as if read from
+    /// Partition `index`/4 of a 3×2 film of 16 spp, as if read from
     /// `p{index}.exr`.
     fn part(index: u32) -> (PathBuf, Header) {
         (PathBuf::from(format!("p{index}.exr")), header(index))
@@ -194,36 +215,38 @@ mod tests {
     #[test]
     fn gaps_and_overlaps_name_the_files() {
         let gap = refusal(&[part(1), part(2), part(4)]);
-        assert!(gap.starts_with("samples 4..6 of the frame's 8 are in none of the files (between `p2.exr` and `p4.exr`)"), "{gap}");
+        assert!(gap.starts_with("samples 8..12 of the frame's 16 are in none of the files (between `p2.exr` and `p4.exr`)"), "{gap}");
         let end = refusal(&[part(3), part(1), part(2)]);
         assert!(
-            end.contains("samples 6..8 of the frame's 8 are in none of the files (after `p3.exr`)"),
+            end.contains(
+                "samples 12..16 of the frame's 16 are in none of the files (after `p3.exr`)"
+            ),
             "{end}"
         );
         let start = refusal(&[part(2), part(3), part(4)]);
         assert!(
             start.contains(
-                "samples 0..2 of the frame's 8 are in none of the files (before `p2.exr`)"
+                "samples 0..4 of the frame's 16 are in none of the files (before `p2.exr`)"
             ),
             "{start}"
         );
         let twice = refusal(&[part(1), part(2), part(2), part(3), part(4)]);
         assert!(
-            twice.contains("`p2.exr` (samples 2..4) and `p2.exr` (samples 2..4) overlap"),
+            twice.contains("`p2.exr` (samples 4..8) and `p2.exr` (samples 4..8) overlap"),
             "{twice}"
         );
         // A half of the frame overlapping a quarter.
         let (path, mut half) = part(1);
-        half.partition = Partition::new(1, 2).expect("valid");
-        half.samples = 0..4;
+        half.partition = Some(Partition::new(1, 2).expect("valid"));
+        half.samples = 0..8;
         let e = refusal(&[(path, half), part(2), part(3), part(4)]);
         assert!(
-            e.contains("`p1.exr` (samples 0..4) and `p2.exr` (samples 2..4) overlap"),
+            e.contains("`p1.exr` (samples 0..8) and `p2.exr` (samples 4..8) overlap"),
             "{e}"
         );
         // Halves and quarters that fit together merge.
         let (path, mut half) = part(1);
-        half.samples = 0..4;
+        half.samples = 0..8;
         assert_eq!(
             order(&[part(4), (path, half), part(3)]).expect("whole"),
             [1, 2, 0]
@@ -237,7 +260,7 @@ mod tests {
             ("scene", |h| h.scene_digest ^= 1),
             ("size", |h| h.width = 4),
             ("frame", |h| h.frame += 1),
-            ("samples per pixel", |h| h.spp = 16),
+            ("samples per pixel", |h| h.spp = 32),
             ("seed", |h| h.seed += 1),
             ("max_depth", |h| h.max_depth = 5),
         ];
@@ -257,5 +280,13 @@ mod tests {
             "same content"
         );
         assert!(matches!(order(&[]), Err(MergeError::Empty)));
+        let (path, mut state) = part(1);
+        state.partition = None;
+        state.samples = 0..5;
+        let e = refusal(&[part(2), (path, state)]);
+        assert!(
+            e.starts_with("`p1.exr` is a progressive render's state (samples 0..5 of 16), not a sample partition: continue it with `radiant render --resume p1.exr`"),
+            "{e}"
+        );
     }
 }

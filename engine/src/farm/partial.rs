@@ -1,16 +1,22 @@
 //! Partial EXR files: what one sample partition of a frame leaves for
-//! [`merge`](super::merge). Beside a viewable preview (`R`, `G`, `B`: the
-//! partition's own developed image) they hold the film's weighted sums as
-//! 32-bit floats, bit for bit (`sum.R`, `sum.G`, `sum.B`: Σ w·L, `sum.W`:
-//! Σ w), because a frame is Σ w·L / Σ w over all its samples and averaging
-//! the partitions' developed images would weight them wrongly wherever
-//! their filter weights differ. The header records the render they belong
-//! to ([`Header`], as `radiant.*` text attributes), so that a merge can
-//! refuse files of other scenes, frames, sizes or seeds.
+//! [`merge`](super::merge), and what a progressive render leaves for
+//! `--resume` (its samples so far). Beside a viewable preview (`R`, `G`,
+//! `B`: the file's own developed image) they hold the film's exact
+//! weighted sums ([`Sums`]: Σ w·r, Σ w·g, Σ w·b, Σ w in 128-bit fixed
+//! point) bit for bit, as four 32-bit unsigned words per sum, least
+//! significant first (`sum.R.0` … `sum.R.3`, `sum.G.*`, `sum.B.*`,
+//! `sum.W.*`), because a frame is Σ w·L / Σ w over all its samples:
+//! averaging the developed images would weight them wrongly wherever their
+//! filter weights differ, and adding exact sums gives the uninterrupted
+//! render's image bit for bit. The header records the render they belong
+//! to ([`Header`], as `radiant.*` text attributes), so that a merge or a
+//! resume can refuse files of other scenes, frames, sizes or seeds.
 
 use crate::farm::partition::Partition;
 use crate::film::Film;
+use crate::film::exact::Sums;
 use crate::film::output::temp_file_beside;
+use crate::settings::RenderSettings;
 use exr::prelude::{
     AnyChannel, AnyChannels, AttributeValue, Encoding, FlatSamples, Image, Layer, LayerAttributes,
     ReadChannels, ReadLayers, SmallVec, Text, WritableImage,
@@ -21,8 +27,14 @@ use std::io::BufWriter;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-/// The channels of the sums, in the order of [`Film::add_layers`].
-const SUM_CHANNELS: [&str; 4] = ["sum.R", "sum.G", "sum.B", "sum.W"];
+/// The sums' channels, in the order of [`Sums::to_words`].
+const SUM_CHANNELS: [&str; 16] = [
+    "sum.R.0", "sum.R.1", "sum.R.2", "sum.R.3", "sum.G.0", "sum.G.1", "sum.G.2", "sum.G.3",
+    "sum.B.0", "sum.B.1", "sum.B.2", "sum.B.3", "sum.W.0", "sum.W.1", "sum.W.2", "sum.W.3",
+];
+
+/// `radiant.partition` of a progressive render's state.
+const NO_PARTITION: &str = "none";
 
 /// What rendered a partial file: the render it is part of and its part.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -38,14 +50,17 @@ pub struct Header {
     pub width: u32,
     /// Film height in pixels.
     pub height: u32,
-    /// Samples per pixel of the whole frame.
+    /// Samples per pixel of the whole frame (of a progressive render: the
+    /// most it renders, which samplers that stratify over the frame's
+    /// samples depend on).
     pub spp: u32,
     /// The frame's sampler seed.
     pub seed: u64,
     /// Longest path in segments (-1: unlimited).
     pub max_depth: i32,
-    /// The partition this file renders.
-    pub partition: Partition,
+    /// The partition this file renders; `None` for a progressive render's
+    /// state (samples `0..n` of `spp`, for `--resume`).
+    pub partition: Option<Partition>,
     /// Its sample indices.
     pub samples: Range<u32>,
     /// Samples that were NaN or infinite and recorded as black.
@@ -53,6 +68,32 @@ pub struct Header {
 }
 
 impl Header {
+    /// The header of a render of `frame` of the scene file `scene` (whose
+    /// bytes are `scene_bytes`) with `settings`: `partition` and `samples`
+    /// as given, no invalid samples yet.
+    pub fn new(
+        scene: &Path,
+        scene_bytes: &[u8],
+        frame: i64,
+        settings: &RenderSettings,
+        partition: Option<Partition>,
+        samples: Range<u32>,
+    ) -> Self {
+        Self {
+            scene: scene.display().to_string(),
+            scene_digest: crc32fast::hash(scene_bytes),
+            frame,
+            width: settings.width,
+            height: settings.height,
+            spp: settings.spp,
+            seed: settings.seed,
+            max_depth: settings.max_depth,
+            partition,
+            samples,
+            invalid_samples: 0,
+        }
+    }
+
     /// What must agree for two files to be parts of one frame, as (what,
     /// value compared, value shown). Scenes compare by content, so the same
     /// scene named by different paths on different machines still merges.
@@ -81,7 +122,11 @@ impl Header {
             ("spp", self.spp.to_string()),
             ("seed", self.seed.to_string()),
             ("max_depth", self.max_depth.to_string()),
-            ("partition", self.partition.to_string()),
+            (
+                "partition",
+                self.partition
+                    .map_or(NO_PARTITION.to_string(), |p| p.to_string()),
+            ),
             (
                 "samples",
                 format!("{}..{}", self.samples.start, self.samples.end),
@@ -100,7 +145,7 @@ pub struct Partial {
     /// What rendered it.
     pub header: Header,
     /// Σ w·r, Σ w·g, Σ w·b, Σ w per pixel, row-major from the top row.
-    pub sums: Vec<f32>,
+    pub sums: Vec<Sums>,
 }
 
 /// Why a partial file could not be read or written.
@@ -160,8 +205,8 @@ pub fn write(path: &Path, header: &Header, film: &Film) -> Result<(), PartialErr
         channels.push(AnyChannel::new(name, FlatSamples::F32(values)));
     }
     for (c, name) in SUM_CHANNELS.into_iter().enumerate() {
-        let values = sums.iter().map(|s| s[c]).collect();
-        channels.push(AnyChannel::new(name, FlatSamples::F32(values)));
+        let values = sums.iter().map(|s| s.to_words()[c]).collect();
+        channels.push(AnyChannel::new(name, FlatSamples::U32(values)));
     }
     let mut attributes = LayerAttributes::named("rgb");
     for (name, value) in header.attributes() {
@@ -232,7 +277,7 @@ pub fn read(path: &Path) -> Result<Partial, PartialError> {
             message: e.to_string(),
         })?;
     let layer = image.layer_data;
-    let mut sums = vec![0.0f32; layer.size.area() * 4];
+    let mut words = vec![[0u32; 16]; layer.size.area()];
     for (c, name) in SUM_CHANNELS.into_iter().enumerate() {
         let not_partial = |missing: String| PartialError::NotPartial {
             path: path.to_path_buf(),
@@ -244,15 +289,16 @@ pub fn read(path: &Path) -> Result<Partial, PartialError> {
             .iter()
             .find(|ch| ch.name.eq(name))
             .ok_or_else(|| not_partial(format!("it has no `{name}` channel")))?;
-        let FlatSamples::F32(values) = &channel.sample_data else {
+        let FlatSamples::U32(values) = &channel.sample_data else {
             return Err(not_partial(format!(
-                "its `{name}` channel does not hold 32-bit floats"
+                "its `{name}` channel does not hold 32-bit integers"
             )));
         };
-        for (sum, &v) in sums.chunks_exact_mut(4).zip(values) {
-            sum[c] = v;
+        for (pixel, &v) in words.iter_mut().zip(values) {
+            pixel[c] = v;
         }
     }
+    let sums = words.iter().map(Sums::from_words).collect();
     Ok(Partial { header, sums })
 }
 
@@ -303,12 +349,20 @@ fn parse_header(
         map: attributes,
     };
     let spp = a.parse("spp")?;
-    let partition: Partition = a.parse("partition")?;
-    // The range must be the partition's: merges rely on it.
+    let partition = a.read("partition", |v| match v {
+        NO_PARTITION => Some(None),
+        v => v.parse::<Partition>().ok().map(Some),
+    })?;
+    // The range must be the partition's (merges rely on it), or a
+    // progressive render's first samples.
     let samples = a.read("samples", |v| {
         let (start, end) = v.split_once("..")?;
         let samples = start.parse().ok()?..end.parse().ok()?;
-        (partition.samples(spp).ok()? == samples).then_some(samples)
+        let valid = match partition {
+            Some(p) => p.samples(spp).ok()? == samples,
+            None => samples.start == 0 && samples.end <= spp,
+        };
+        valid.then_some(samples)
     })?;
     Ok(Header {
         scene: a.text("scene")?,
@@ -331,7 +385,7 @@ fn parse_header(
 pub(crate) mod tests {
     use super::*;
 
-    /// A header for a 3×2 film, partition `index`/4 of 8 spp.
+    /// A header for a 3×2 film, partition `index`/4 of 16 spp.
     pub(crate) fn header(index: u32) -> Header {
         let partition = Partition::new(index, 4).expect("valid");
         Header {
@@ -340,11 +394,11 @@ pub(crate) mod tests {
             frame: 7,
             width: 3,
             height: 2,
-            spp: 8,
+            spp: 16,
             seed: 11,
             max_depth: -1,
-            partition,
-            samples: partition.samples(8).expect("enough samples"),
+            partition: Some(partition),
+            samples: partition.samples(16).expect("enough samples"),
             invalid_samples: 2,
         }
     }
@@ -359,8 +413,16 @@ pub(crate) mod tests {
         write(&path, &header(2), &film).expect("writes");
         let partial = read(&path).expect("reads");
         assert_eq!(partial.header, header(2));
-        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        assert_eq!(bits(&partial.sums), bits(&layer));
+        assert_eq!(partial.sums, film.sums());
+        // Sums beyond f32's range and precision survive too.
+        let mut exact = Film::new(3, 2);
+        let mut sums = vec![Sums::ZERO; 6];
+        sums[1] = Sums([i128::MAX, -1, 1, i128::MIN]);
+        sums[4] = Sums([(1 << 100) + 1, 3, -(1 << 90), 1 << 64]);
+        exact.add_sums(&sums, 0);
+        write(&path, &header(2), &exact).expect("writes");
+        assert_eq!(read(&path).expect("reads").sums, sums);
+        write(&path, &header(2), &film).expect("writes");
         // The preview is the partition's own image.
         let preview = crate::film::output::read_exr(&path).expect("reads as an image");
         assert_eq!(preview, film.develop());

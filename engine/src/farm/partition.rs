@@ -1,8 +1,11 @@
 //! Sample partitions (`--partition K/N`): the K-th of N disjoint, adjacent
 //! ranges of a frame's sample indices. Every sampler draws sample `i` of a
 //! pixel from (seed, pixel, `i`) alone, so the partitions of a frame are
-//! disjoint sampler streams whose union is the whole frame's samples.
+//! disjoint sampler streams whose union is the whole frame's samples. They
+//! start on block boundaries ([`BLOCK`]), so their exact film sums add up to
+//! the single render's bit for bit.
 
+use crate::film::exact::BLOCK;
 use std::fmt;
 use std::ops::Range;
 use std::str::FromStr;
@@ -28,9 +31,9 @@ pub enum PartitionError {
         /// N.
         count: u32,
     },
-    /// More partitions than samples, so some would be empty.
+    /// More partitions than blocks of samples, so some would be empty.
     #[error(
-        "{count} partitions of {spp} samples per pixel would leave some empty: use at most {spp} partitions or more samples (--spp)"
+        "{count} partitions of {spp} samples per pixel would leave some empty (partitions hold whole blocks of {BLOCK} samples): use at most {} partitions or more samples (--spp)", spp.div_ceil(BLOCK)
     )]
     TooMany {
         /// N.
@@ -60,17 +63,22 @@ impl Partition {
     }
 
     /// The sample indices of this partition of a frame of `spp` samples per
-    /// pixel: partition K of N takes ⌊(K−1)·spp/N⌋ .. ⌊K·spp/N⌋, so the N
-    /// ranges are adjacent, disjoint and cover 0..spp, and their sizes differ
-    /// by at most one.
+    /// pixel, in whole blocks of [`BLOCK`] samples: of the B = ⌈spp/4⌉
+    /// blocks, partition K of N takes blocks ⌊(K−1)·B/N⌋ .. ⌊K·B/N⌋ (the
+    /// last one ending at `spp`), so the N ranges are adjacent, disjoint and
+    /// cover 0..spp, and their sizes differ by at most a block.
     pub fn samples(self, spp: u32) -> Result<Range<u32>, PartitionError> {
-        if self.count > spp {
+        let blocks = spp.div_ceil(BLOCK);
+        if self.count > blocks {
             return Err(PartitionError::TooMany {
                 count: self.count,
                 spp,
             });
         }
-        let bound = |k: u32| (u64::from(k) * u64::from(spp) / u64::from(self.count)) as u32;
+        let bound = |k: u32| {
+            let block = u64::from(k) * u64::from(blocks) / u64::from(self.count);
+            (block * u64::from(BLOCK)).min(u64::from(spp)) as u32
+        };
         Ok(bound(self.index - 1)..bound(self.index))
     }
 }
@@ -117,17 +125,20 @@ mod tests {
     }
 
     #[test]
-    fn partitions_tile_the_samples() {
-        for (spp, n) in [(4096, 16), (10, 3), (7, 7), (1, 1), (u32::MAX, 5)] {
+    fn partitions_tile_the_samples_in_whole_blocks() {
+        for (spp, n) in [(4096, 16), (10, 3), (7, 2), (1, 1), (37, 9), (u32::MAX, 5)] {
             let mut next = 0;
+            let blocks = spp.div_ceil(BLOCK);
             for k in 1..=n {
                 let r = Partition::new(k, n)
                     .expect("valid")
                     .samples(spp)
                     .expect("enough samples");
                 assert_eq!(r.start, next, "adjacent");
+                assert_eq!(r.start % BLOCK, 0, "starts on a block");
                 assert!(!r.is_empty());
-                assert!(r.len() as u32 >= spp / n && r.len() as u32 <= spp / n + 1);
+                let size = r.end.div_ceil(BLOCK) - r.start / BLOCK;
+                assert!(size >= blocks / n && size <= blocks / n + 1, "{spp} {n}");
                 next = r.end;
             }
             assert_eq!(next, spp, "complete");
@@ -136,9 +147,15 @@ mod tests {
             Partition::new(3, 16).expect("valid").samples(4096),
             Ok(512..768)
         );
+        assert_eq!(Partition::new(3, 3).expect("valid").samples(10), Ok(8..10));
         assert_eq!(
-            Partition::new(1, 16).expect("valid").samples(8),
-            Err(PartitionError::TooMany { count: 16, spp: 8 })
+            Partition::new(1, 3).expect("valid").samples(8),
+            Err(PartitionError::TooMany { count: 3, spp: 8 })
+        );
+        assert!(
+            PartitionError::TooMany { count: 3, spp: 8 }
+                .to_string()
+                .contains("use at most 2 partitions")
         );
     }
 }

@@ -7,7 +7,7 @@
 //! geometry and what it costs in memory.
 
 use super::encode;
-use super::memory::{FrameTooLarge, IMAGE_BYTES, SUM_BYTES};
+use super::memory::{FrameTooLarge, IMAGE_BYTES, SUM_BYTES, TILE_BYTES};
 use std::ops::Range;
 
 /// How a frame is cut into groups of tile rows, and the rows of film that
@@ -80,7 +80,7 @@ impl Bands {
                     "finished rows on their way to the file",
                     w * rows * IMAGE_BYTES,
                 ),
-                ("the tiles in flight", tiles * tile_pixels * SUM_BYTES),
+                ("the tiles in flight", tiles * tile_pixels * TILE_BYTES),
                 (
                     "the encoder",
                     encode::buffer_bytes(self.width, self.rows(), threads),

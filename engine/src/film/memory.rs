@@ -9,8 +9,12 @@ use radiant_core::Rgb;
 use radiant_core::memory::{self, gib};
 use std::fmt;
 
-/// Bytes per pixel of the film's weighted sums (RGB and weight, f32).
-pub const SUM_BYTES: u64 = 16;
+/// Bytes per pixel of the film's weighted sums (RGB and weight, exact
+/// 128-bit fixed point: [`super::exact::Sums`]).
+pub const SUM_BYTES: u64 = std::mem::size_of::<super::exact::Sums>() as u64;
+/// Bytes per pixel of a tile: its exact sums and the `f32` sums of the
+/// sample index being splatted.
+pub const TILE_BYTES: u64 = SUM_BYTES + 16;
 /// Bytes per pixel of the developed image (RGB, f32).
 pub const IMAGE_BYTES: u64 = std::mem::size_of::<Rgb>() as u64;
 
@@ -152,18 +156,21 @@ mod tests {
             available: Some(4 << 30),
             ..FrameTooLarge::new(32768, 32768)
         };
-        assert_eq!(e.needed(), 32768 * 32768 * 28);
+        // 64 bytes of exact sums and 12 of image per pixel.
+        assert_eq!(SUM_BYTES, 64);
+        assert_eq!(e.needed(), 32768 * 32768 * 76);
         let shown = e.to_string();
         assert!(
-            shown.starts_with("a 32768×32768 frame needs 28.00 GiB"),
+            shown.starts_with("a 32768×32768 frame needs 76.00 GiB"),
             "{shown}"
         );
         assert!(
-            shown.contains("16.00 GiB for the film's weighted sums"),
+            shown.contains("64.00 GiB for the film's weighted sums"),
             "{shown}"
         );
+        // 4 GiB / (32768 × 76 bytes) = 1724.6 rows.
         assert!(
-            shown.contains("enough for 4681 rows at this width"),
+            shown.contains("enough for 1724 rows at this width"),
             "{shown}"
         );
         assert!(e.check().is_err());

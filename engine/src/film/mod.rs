@@ -1,8 +1,12 @@
 //! The film: filtered accumulation of samples, and image output.
 //!
 //! Each render task splats its samples into a [`TileFilm`] that covers its
-//! pixels plus the filter's border; tiles are merged into the [`Film`] in a
-//! fixed order, so a render is bit-identical whatever the thread count.
+//! pixels plus the filter's border; the splats of one block of sample
+//! indices are added in `f32` in a fixed order and then converted into
+//! exact fixed-point sums ([`exact`]), which tiles add into the [`Film`].
+//! Integer addition is associative, so a render is bit-identical whatever
+//! the thread count, and whatever block-aligned sample ranges (passes,
+//! partitions, resumed renders) its samples were rendered in.
 //! A pixel's value is Σ w·L / Σ w over the samples whose filter footprint
 //! covers it (Mitsuba 3 and pbrt semantics). [`Reconstruction`] chooses
 //! how samples get their weights: splatted into every pixel in the
@@ -14,6 +18,7 @@ pub mod band;
 pub mod denoise;
 pub mod encode;
 pub mod encoding;
+pub mod exact;
 pub mod layers;
 pub mod memory;
 pub mod output;
@@ -22,6 +27,7 @@ pub mod sheet;
 pub mod tonemap;
 
 use crate::settings::FilterSampling;
+use exact::Sums;
 use glam::{Vec2, Vec4};
 use radiant_core::{Filter, FilterSampler, Rgb};
 
@@ -176,8 +182,11 @@ pub struct TileFilm {
     height: i32,
     image_width: i32,
     image_height: i32,
-    /// (Σ w·r, Σ w·g, Σ w·b, Σ w) per pixel.
-    sums: Vec<Vec4>,
+    /// (Σ w·r, Σ w·g, Σ w·b, Σ w) per pixel of the splats since the last
+    /// [`TileFilm::end_block`], in `f32`.
+    current: Vec<Vec4>,
+    /// The exact sums of the blocks ended so far.
+    sums: Vec<Sums>,
     /// Samples whose value was NaN or infinite (recorded as zero).
     pub invalid_samples: u64,
 }
@@ -199,8 +208,23 @@ impl TileFilm {
             height: by1 - by0,
             image_width: w,
             image_height: h,
-            sums: vec![Vec4::ZERO; ((bx1 - bx0) * (by1 - by0)) as usize],
+            current: vec![Vec4::ZERO; ((bx1 - bx0) * (by1 - by0)) as usize],
+            sums: vec![Sums::ZERO; ((bx1 - bx0) * (by1 - by0)) as usize],
             invalid_samples: 0,
+        }
+    }
+
+    /// Ends a block of sample indices ([`exact::BLOCK`]): the `f32` sums
+    /// of its splats are converted into the exact sums. A render splats
+    /// the block's sample indices in order, each over all the tile's
+    /// pixels in order, between calls, so the exact sums do not depend on
+    /// how the samples were cut into batches.
+    pub fn end_block(&mut self) {
+        for (sum, current) in self.sums.iter_mut().zip(&mut self.current) {
+            if *current != Vec4::ZERO {
+                sum.add_f32(*current);
+                *current = Vec4::ZERO;
+            }
         }
     }
 
@@ -225,7 +249,10 @@ impl TileFilm {
             let mut start = ((py0 - self.y0) * self.width + px0 - self.x0) as usize;
             for y in py0..=py1 {
                 let vy = v * table.factor(g, y as f32 + 0.5 - pos.y);
-                for (sum, &w) in self.sums[start..start + taps].iter_mut().zip(&wx[..taps]) {
+                for (sum, &w) in self.current[start..start + taps]
+                    .iter_mut()
+                    .zip(&wx[..taps])
+                {
                     *sum += vy * w;
                 }
                 start += self.width as usize;
@@ -234,7 +261,7 @@ impl TileFilm {
         }
         for y in py0..=py1 {
             let dy = y as f32 + 0.5 - pos.y;
-            let row = &mut self.sums[((y - self.y0) * self.width) as usize..];
+            let row = &mut self.current[((y - self.y0) * self.width) as usize..];
             for x in px0..=px1 {
                 let w = table.weight(x as f32 + 0.5 - pos.x, dy);
                 if w != 0.0 {
@@ -262,7 +289,7 @@ impl TileFilm {
     pub fn add(&mut self, x: u32, y: u32, value: Rgb, weight: f32) {
         let value = self.checked(value);
         let i = ((y as i32 - self.y0) * self.width + x as i32 - self.x0) as usize;
-        self.sums[i] += (value * weight).extend(weight);
+        self.current[i] += (value * weight).extend(weight);
     }
 }
 
@@ -293,7 +320,7 @@ pub struct Film {
     /// Rows held at most (all of them for a whole film).
     band: u32,
     /// Rows `top..top + sums.len() / width`, row-major.
-    sums: Vec<Vec4>,
+    sums: Vec<Sums>,
     /// Samples whose value was NaN or infinite (recorded as zero).
     pub invalid_samples: u64,
 }
@@ -322,7 +349,7 @@ impl Film {
     /// their memory cannot be reserved.
     pub fn try_band(width: u32, height: u32, rows: u32) -> Option<Self> {
         let band = rows.clamp(1, height.max(1));
-        let sums = memory::try_filled(band as usize * width as usize, Vec4::ZERO)?;
+        let sums = memory::try_filled(band as usize * width as usize, Sums::ZERO)?;
         Some(Self {
             width,
             height,
@@ -338,9 +365,11 @@ impl Film {
         (self.sums.len() / self.width.max(1) as usize) as u32
     }
 
-    /// Adds layers of per-pixel sums (Σ w·L in RGB, Σ w in alpha; each
-    /// layer `width × height` pixels, row-major) and `invalid` samples —
-    /// what the GPU backend renders.
+    /// Adds layers of per-pixel `f32` sums (Σ w·L in RGB, Σ w in alpha;
+    /// each layer `width × height` pixels, row-major) and `invalid`
+    /// samples — what the GPU backend renders. Each layer's sums are
+    /// converted exactly, so the result is exact given the layers (but the
+    /// layers' own `f32` sums depend on how the GPU split the samples).
     ///
     /// # Panics
     ///
@@ -352,24 +381,52 @@ impl Film {
         assert_eq!(layers.len() % layer.max(1), 0, "not whole layers");
         for l in layers.chunks_exact(layer.max(1)) {
             for (sum, p) in self.sums.iter_mut().zip(l.chunks_exact(4)) {
-                *sum += Vec4::new(p[0], p[1], p[2], p[3]);
+                sum.add_f32(Vec4::new(p[0], p[1], p[2], p[3]));
             }
         }
         self.invalid_samples += invalid;
     }
 
-    /// The sums of a whole film (Σ w·L in RGB, Σ w in alpha), row-major:
-    /// what a sample partition stores for `radiant merge` to add.
+    /// Adds the exact sums of a whole film (`width × height` pixels,
+    /// row-major; a partial or resumable file's) and `invalid` samples.
+    ///
+    /// # Panics
+    ///
+    /// If `sums` is not one film of this size, or the film holds a band
+    /// rather than the whole frame.
+    pub fn add_sums(&mut self, sums: &[Sums], invalid: u64) {
+        assert!(self.top == 0 && self.rows() == self.height, "a whole film");
+        assert_eq!(sums.len(), self.sums.len(), "not one film");
+        for (sum, s) in self.sums.iter_mut().zip(sums) {
+            sum.add(s);
+        }
+        self.invalid_samples += invalid;
+    }
+
+    /// The exact sums of a whole film, row-major: what a sample partition
+    /// or a resumable render stores for `radiant merge` or `--resume` to
+    /// add.
     ///
     /// # Panics
     ///
     /// If the film holds a band rather than the whole frame.
-    pub fn sums(&self) -> &[Vec4] {
+    pub fn sums(&self) -> &[Sums] {
         assert!(self.top == 0 && self.rows() == self.height, "a whole film");
         &self.sums
     }
 
-    /// Adds a tile's sums.
+    /// Film width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Film height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Adds a tile's sums (the splats of a block it has not ended, at the
+    /// end of its samples, count as one more block).
     ///
     /// # Panics
     ///
@@ -388,7 +445,9 @@ impl Film {
             let dst =
                 ((tile.y0 as u32 + y as u32 - self.top) * self.width + tile.x0 as u32) as usize;
             for x in 0..tile.width as usize {
-                self.sums[dst + x] += tile.sums[src + x];
+                let sum = &mut self.sums[dst + x];
+                sum.add(&tile.sums[src + x]);
+                sum.add_f32(tile.current[src + x]);
             }
         }
         self.invalid_samples += tile.invalid_samples;
@@ -414,13 +473,13 @@ impl Film {
         );
         let done = (until - self.top) as usize * self.width as usize;
         finished.try_reserve(done)?;
-        finished.extend(self.sums[..done].iter().map(develop));
+        finished.extend(self.sums[..done].iter().map(Sums::develop));
         self.sums.drain(..done);
         self.top = until;
         let bottom = (self.top + self.band).min(self.height);
         self.sums.resize(
             (bottom - self.top) as usize * self.width as usize,
-            Vec4::ZERO,
+            Sums::ZERO,
         );
         Ok(())
     }
@@ -447,23 +506,12 @@ impl Film {
         if pixels.try_reserve_exact(self.sums.len()).is_err() {
             return Err(memory::FrameTooLarge::new(self.width, self.height));
         }
-        pixels.extend(self.sums.iter().map(develop));
+        pixels.extend(self.sums.iter().map(Sums::develop));
         Ok(Image {
             width: self.width,
             height: self.height,
             pixels,
         })
-    }
-}
-
-/// A pixel's value from its sums: Σ w·L / Σ w, black where no weight
-/// reached it.
-#[inline]
-fn develop(sum: &Vec4) -> Rgb {
-    if sum.w > 0.0 {
-        sum.truncate() / sum.w
-    } else {
-        Rgb::ZERO
     }
 }
 
@@ -612,7 +660,7 @@ mod tests {
             fast.splat(pos, value, &table);
             slow.splat(pos, value, &general);
         }
-        for (a, b) in fast.sums.iter().zip(&slow.sums) {
+        for (a, b) in fast.current.iter().zip(&slow.current) {
             assert!((*a - *b).abs().max_element() <= 1e-5 * b.abs().max_element().max(1.0));
         }
     }

@@ -24,6 +24,7 @@ use crate::accel::offset::{offset_origin, sampled_point_error};
 use crate::accel::{Hit, Motion};
 use crate::extract::{NO_EMITTER, RenderScene};
 use crate::film::aov::{AovTile, FirstHit};
+use crate::film::exact::BLOCK;
 use crate::film::{Reconstruction, TileFilm};
 use glam::{Vec2, Vec3};
 use radiant_core::{
@@ -263,23 +264,34 @@ impl Wavefront {
         if scene.settings.max_depth != 0 {
             self.trace_paths(scene);
         }
-        match reconstruction {
-            Reconstruction::Splat(table) => {
-                for (&pos, &value) in self.film[..n].iter().zip(&self.radiance[..n]) {
-                    tile.splat(pos, value, table);
+        // One sample index at a time over the batch's pixels (slots are
+        // pixel-major), each block of sample indices ended into the tile's
+        // exact sums: the tile's sums then do not depend on which sample
+        // indices a batch holds.
+        let count = batch.samples as usize;
+        for (first, index) in (0..count).zip(batch.first_sample..) {
+            let slots = (first..n).step_by(count);
+            match reconstruction {
+                Reconstruction::Splat(table) => {
+                    for i in slots {
+                        tile.splat(self.film[i], self.radiance[i], table);
+                    }
+                }
+                Reconstruction::Importance(_) => {
+                    let width = scene.settings.width;
+                    for i in slots {
+                        let pixel = self.ids[i].pixel;
+                        tile.add(
+                            pixel % width,
+                            pixel / width,
+                            self.radiance[i],
+                            self.filter_weight[i],
+                        );
+                    }
                 }
             }
-            Reconstruction::Importance(_) => {
-                let width = scene.settings.width;
-                for i in 0..n {
-                    let pixel = self.ids[i].pixel;
-                    tile.add(
-                        pixel % width,
-                        pixel / width,
-                        self.radiance[i],
-                        self.filter_weight[i],
-                    );
-                }
+            if (index + 1) % BLOCK == 0 {
+                tile.end_block();
             }
         }
         if let Some(aovs) = aovs {

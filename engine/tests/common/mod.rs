@@ -144,10 +144,3 @@ pub fn difference(a: &Image, b: &Image) -> (f32, usize) {
         .count();
     (largest / peak, same)
 }
-
-/// The most a merged frame may differ from the single-machine render of
-/// the same samples, relative to its brightest value: the two add the same
-/// float contributions in a different order (see README, "Rendering on a
-/// Slurm cluster"), which moves a sum by a few units in its last place. A
-/// frame of other samples differs by percents.
-pub const ROUNDING: f32 = 1e-5;

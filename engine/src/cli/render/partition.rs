@@ -74,17 +74,15 @@ pub(super) fn run(
         .install(|| backend.render_samples(s, &mut film, samples.clone(), &Progress::none()))
         .map_err(|e| miette::miette!("{e}"))?;
     let header = Header {
-        scene: args.scene.display().to_string(),
-        scene_digest: crc32fast::hash(&scene_bytes),
-        frame,
-        width: settings.width,
-        height: settings.height,
-        spp: settings.spp,
-        seed: settings.seed,
-        max_depth: settings.max_depth,
-        partition,
-        samples: samples.clone(),
         invalid_samples: film.invalid_samples,
+        ..Header::new(
+            &args.scene,
+            &scene_bytes,
+            frame,
+            settings,
+            Some(partition),
+            samples.clone(),
+        )
     };
     partial::write(&output, &header, &film).map_err(|e| miette::miette!("{e}"))?;
     eprintln!(

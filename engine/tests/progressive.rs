@@ -1,0 +1,273 @@
+//! Progressive renders end to end: `--time` stops within one pass of its
+//! limit, `--checkpoint` files appear while the render runs and are valid,
+//! a render interrupted by SIGINT after its first checkpoint and resumed
+//! gives the uninterrupted render's image bit for bit, a PNG render keeps
+//! its state beside it, and wrong `--resume` inputs are refused naming the
+//! file.
+
+// `unwrap`/`expect` in this test code is the assertion: the inputs are the
+// test's own, so a failure is a bug, and the panic reports it.
+
+#[allow(dead_code)]
+mod common;
+
+use common::{arg, radiant, read, shot, stderr};
+use radiant::farm::partial;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// The arguments of `radiant render SCENE -o OUT` on the CPU with two
+/// threads and `extra`.
+fn render_args<'a>(scene: &'a Path, out: &'a Path, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec![
+        "render",
+        arg(scene),
+        "-o",
+        arg(out),
+        "--backend",
+        "cpu",
+        "--threads",
+        "2",
+    ];
+    args.extend(extra);
+    args
+}
+
+/// Runs `radiant render SCENE -o OUT` on the CPU with `extra` options.
+fn render(scene: &Path, out: &Path, extra: &[&str]) -> Output {
+    radiant(&render_args(scene, out, extra))
+}
+
+/// Like [`render`], and checks that it succeeded; returns its stderr.
+fn rendered(scene: &Path, out: &Path, extra: &[&str]) -> String {
+    let o = render(scene, out, extra);
+    assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+    stderr(&o)
+}
+
+/// The number after `key` in `text` (`key` ends just before it).
+fn number_after(text: &str, key: &str) -> f64 {
+    let at = text
+        .find(key)
+        .unwrap_or_else(|| panic!("`{key}` in {text}"))
+        + key.len();
+    let digits: String = text[at..]
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || *c == '.')
+        .collect();
+    digits.parse().unwrap()
+}
+
+/// Samples per pixel the state file `path` holds.
+fn samples_in(path: &Path) -> u32 {
+    partial::read_header(path).unwrap().samples.end
+}
+
+#[test]
+fn time_limited_renders_stop_within_a_pass_of_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = shot(dir.path(), "shot.yaml", "independent");
+    let out = dir.path().join("timed.exr");
+    let limit = 2.0;
+    let started = Instant::now();
+    let e = rendered(&scene, &out, &["--time", "2s", "--spp", "1000000"]);
+    let wall = started.elapsed().as_secs_f64();
+    // "time up: N of 1000000 spp in P passes (longest L s)" and the
+    // render's time "in T s".
+    let samples = number_after(&e, "time up: ") as u32;
+    let passes = number_after(&e, "spp in ");
+    let longest = number_after(&e, "(longest ");
+    let time = number_after(&e, &format!(", {samples} spp in "));
+    eprintln!("{samples} spp in {passes} passes, longest {longest} s, {time} s; wall {wall:.2} s");
+    assert!(passes >= 2.0, "{e}");
+    // Whole passes until the time is up: not short of the limit by more
+    // than a pass, and past it by at most one pass (and some slack for a
+    // loaded machine).
+    let slack = 0.25;
+    assert!(time >= limit - longest - slack, "{e}");
+    assert!(time <= limit + longest + slack, "{e}");
+    assert!(wall <= limit + longest + 20.0, "{wall}");
+    // The file holds what was said.
+    assert_eq!(samples_in(&out), samples);
+    assert!(read(&out).mean() > 0.0);
+}
+
+/// Renders `scene` to `out` with `extra` options in a child process, sends
+/// it SIGINT once `out` has appeared (its first checkpoint) and returns its
+/// output.
+fn interrupted(scene: &Path, out: &Path, extra: &[&str]) -> Output {
+    let child = Command::new(env!("CARGO_BIN_EXE_radiant"))
+        .args(render_args(scene, out, extra))
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while !out.exists() {
+        assert!(Instant::now() < deadline, "no checkpoint in 120 s");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    // A checkpoint is a valid state of fewer samples than asked for.
+    let first = samples_in(out);
+    assert!(first >= 1, "{first}");
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    child.wait_with_output().unwrap()
+}
+
+#[test]
+fn an_interrupted_render_resumes_into_the_uninterrupted_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = shot(dir.path(), "shot.yaml", "independent");
+    // Enough samples for several seconds: what one second renders, times 8.
+    let probe = dir.path().join("probe.exr");
+    rendered(&scene, &probe, &["--time", "1s", "--spp", "1000000"]);
+    let spp = (samples_in(&probe) * 8).max(64).to_string();
+
+    let out = dir.path().join("frame.exr");
+    let o = interrupted(&scene, &out, &["--spp", &spp, "--checkpoint", "0.2s"]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(130), "{e}");
+    let held = samples_in(&out);
+    assert!(held < spp.parse().unwrap(), "{e}");
+    assert!(
+        e.contains(&format!(
+            "interrupted: {held} of {spp} spp written to {}; continue with --resume {}",
+            out.display(),
+            out.display()
+        )),
+        "{e}"
+    );
+    // No temporary file is left beside it.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3);
+
+    let e = rendered(
+        &scene,
+        &out,
+        &["--spp", &spp, "--resume", arg(&out), "--checkpoint", "1s"],
+    );
+    assert!(e.contains(&format!("{spp} of {spp} spp")), "{e}");
+    let single = dir.path().join("single.exr");
+    rendered(&scene, &single, &["--spp", &spp]);
+    let (resumed, single) = (read(&out), read(&single));
+    assert!(resumed == single, "resumed image differs from one render");
+    assert!(single.mean() > 0.0);
+}
+
+#[test]
+fn a_png_render_keeps_its_state_beside_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = shot(dir.path(), "shot.yaml", "sobol");
+    let png = dir.path().join("frame.png");
+    let state = dir.path().join("frame.png.resume.exr");
+    rendered(&scene, &png, &["--spp", "16", "--checkpoint", "10s"]);
+    assert!(png.exists() && state.exists());
+    assert_eq!(samples_in(&state), 16);
+    // A PNG holds no state; the message points at the file beside it.
+    let o = render(&scene, &png, &["--spp", "32", "--resume", arg(&png)]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains(&format!(
+            "cannot resume from `{}`: only EXR files hold a render's state; this render's state is in `{}`",
+            png.display(),
+            state.display()
+        )),
+        "{}",
+        stderr(&o)
+    );
+    // Resumed from 16 to 32 samples, it is the 32-sample render (the
+    // sobol sampler's samples do not depend on how many there are).
+    rendered(&scene, &png, &["--spp", "32", "--resume", arg(&state)]);
+    let exr = dir.path().join("single.exr");
+    rendered(&scene, &exr, &["--spp", "32"]);
+    assert_eq!(samples_in(&state), 32);
+    assert!(read(&state) == read(&exr));
+}
+
+/// Runs a render resuming from `from` with `extra` options, expects it to
+/// fail with each of `needles` in its message, and checks that it wrote
+/// nothing.
+fn refused(scene: &Path, from: &Path, extra: &[&str], needles: &[&str]) {
+    let out = from.with_file_name("out.exr");
+    let mut options = vec!["--resume", arg(from)];
+    options.extend(extra);
+    let o = render(scene, &out, &options);
+    assert!(!o.status.success(), "{extra:?} succeeded");
+    let e = stderr(&o);
+    for needle in needles {
+        assert!(e.contains(needle), "`{needle}` not in: {e}");
+    }
+    assert!(!out.exists(), "an output was left");
+}
+
+#[test]
+fn wrong_resume_inputs_name_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = shot(dir.path(), "shot.yaml", "independent");
+    let state = dir.path().join("state.exr");
+    rendered(&scene, &state, &["--spp", "8", "--time", "60s"]);
+    let name = |p: &PathBuf| format!("cannot resume from `{}`", p.display());
+    // Another scene: the same file edited.
+    let edited = dir.path().join("edited.yaml");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(&edited, text.replace("0.7", "0.6")).unwrap();
+    refused(
+        &edited,
+        &state,
+        &[],
+        &[&name(&state), "it renders a different scene"],
+    );
+    refused(
+        &scene,
+        &state,
+        &["--width", "16"],
+        &[&name(&state), "different size (32x32 there, 16x32 here)"],
+    );
+    refused(
+        &scene,
+        &state,
+        &["--seed", "99"],
+        &[&name(&state), "different seed"],
+    );
+    refused(
+        &scene,
+        &state,
+        &["--spp", "4"],
+        &[
+            &name(&state),
+            "it holds 8 samples per pixel, more than the 4",
+        ],
+    );
+    // A plain EXR and a PNG hold no state; a missing file is named.
+    let plain = dir.path().join("plain.exr");
+    rendered(&scene, &plain, &["--spp", "2"]);
+    refused(
+        &scene,
+        &plain,
+        &[],
+        &[&name(&plain), "has no `radiant.", "--resume takes the EXR"],
+    );
+    let png = dir.path().join("plain.png");
+    rendered(&scene, &png, &["--spp", "2"]);
+    refused(
+        &scene,
+        &png,
+        &[],
+        &[&name(&png), "only EXR files hold a render's state"],
+    );
+    let missing = dir.path().join("missing.exr");
+    refused(&scene, &missing, &[], &[&name(&missing)]);
+    // A sample partition goes to `radiant merge`.
+    let part = dir.path().join("part.exr");
+    rendered(&scene, &part, &["--spp", "8", "--partition", "1/2"]);
+    refused(
+        &scene,
+        &part,
+        &["--spp", "8"],
+        &[&name(&part), "it is sample partition 1/2 of a frame"],
+    );
+}
