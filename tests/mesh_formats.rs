@@ -225,10 +225,14 @@ sampler: {type: independent, spp: 16}
 /// Renders `body` (after [`SETTINGS`], with an environment light added
 /// where it has a `lights:` list) in `tests/data/meshes/`.
 fn render_text(body: &str) -> Result<Image, String> {
+    render_text_in(&radiant_tests::root().join("tests/data/meshes"), body)
+}
+
+/// As [`render_text`], with files relative to `dir`.
+fn render_text_in(dir: &Path, body: &str) -> Result<Image, String> {
     use radiant::backend::cpu::{Progress, render};
-    let dir = radiant_tests::root().join("tests/data/meshes");
     let text = format!("{SETTINGS}{body}  - {{type: environment, radiance: 0.1}}\n");
-    let scene = radiant::scene::from_str(&text, &dir.join("gltf-test.yaml"), &dir)
+    let scene = radiant::scene::from_str(&text, &dir.join("gltf-test.yaml"), dir)
         .map_err(|e| e.to_string())?;
     let r = radiant::extract::extract(&scene, &radiant::builtin_registry(), &Overrides::default())
         .map_err(|e| e.to_string())?;
@@ -301,6 +305,56 @@ fn gltf_nodes_material_texture_camera_and_lights_are_imported() {
         d < SAME_SCENE,
         "lights: false differs from the scene without the lights: {d}"
     );
+}
+
+/// A glTF material's normal texture becomes a `normal_map` around its
+/// `principled` material (the image read raw), and its emissive factor an
+/// `area` emitter on its meshes.
+#[test]
+fn gltf_normal_textures_and_emission_are_imported() {
+    let data = radiant_tests::root().join("tests/data/meshes");
+    let dir = tempfile::tempdir().expect("temporary folders can be made");
+    for file in ["checks.png", "torus-uv.obj"] {
+        std::fs::copy(data.join(file), dir.path().join(file)).expect("copyable");
+    }
+    let text = std::fs::read_to_string(data.join("scene.gltf")).expect("the glTF is committed");
+    let from = "\"name\": \"checked metal\",";
+    assert!(text.contains(from));
+    let edited = text.replace(
+        from,
+        "\"name\": \"checked metal\", \"normalTexture\": {\"index\": 0}, \"emissiveFactor\": [0.2, 0.1, 0.05],",
+    );
+    std::fs::write(dir.path().join("scene.gltf"), edited).expect("writable");
+    let gltf = render_text_in(
+        dir.path(),
+        "camera: {type: gltf, filename: scene.gltf}\nshapes:\n  - {type: gltf, filename: scene.gltf}\nlights:\n",
+    )
+    .expect("the glTF scene renders");
+    let twin = |material: &str, emitter: &str| {
+        let yaml = GLTF_AS_YAML
+            .replace(
+                "textures: {checks: {type: image, filename: checks.png}}",
+                "textures: {checks: {type: image, filename: checks.png}, \
+                 raw: {type: image, filename: checks.png, raw: true}}",
+            )
+            .replace(
+                "materials: {torus: {type: principled, base_color: checks, metallic: 0.3, roughness: 0.6}}",
+                &format!("materials: {{torus: {material}}}"),
+            )
+            .replace("material: torus,", &format!("material: torus, {emitter}"));
+        render_text_in(dir.path(), &yaml).expect("the YAML twin renders")
+    };
+    let principled = "{type: principled, base_color: checks, metallic: 0.3, roughness: 0.6}";
+    let mapped = format!("{{type: normal_map, normals: raw, material: {principled}}}");
+    let glow = "emitter: {type: area, radiance: [0.2, 0.1, 0.05]},";
+    let same = relative_difference(&gltf, &twin(&mapped, glow));
+    eprintln!("glTF against YAML: {same:.2e}");
+    assert!(same < SAME_SCENE, "differs from its YAML twin: {same}");
+    for (material, emitter) in [(principled, glow), (mapped.as_str(), "")] {
+        let d = relative_difference(&gltf, &twin(material, emitter));
+        eprintln!("{material} {emitter}: {d:.5}");
+        assert!(d > 5.0 * SAME_SCENE, "{material} {emitter}: only {d}");
+    }
 }
 
 const POINT_LIGHT_LINE: &str =
