@@ -174,7 +174,7 @@ fn bad_requests_are_refused_before_rendering() {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("square.yaml");
     std::fs::write(&scene, SCENE).unwrap();
-    let cases: [(&[&str], &str, &str); 3] = [
+    let cases: [(&[&str], &str, &str); 4] = [
         (
             &["--aov", "albedo,nromal"],
             "a.exr",
@@ -185,6 +185,11 @@ fn bad_requests_are_refused_before_rendering() {
             &["--aov", "depth", "--backend", "gpu"],
             "a.exr",
             "--aov needs the CPU backend",
+        ),
+        (
+            &["--aov", "depth", "--time", "5s"],
+            "a.exr",
+            "--aov cannot be combined with --time",
         ),
     ];
     for (extra, name, message) in cases {

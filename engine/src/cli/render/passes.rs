@@ -83,6 +83,12 @@ pub(super) fn check(args: &RenderArgs) -> miette::Result<()> {
              use `--backend cpu` (or `auto`, which renders such frames on the CPU)"
         );
     }
+    if args.progressive.is_set() {
+        miette::bail!(
+            "{what} cannot be combined with --time, --checkpoint or --resume yet: the planes \
+             are not kept between passes; render a fixed --spp"
+        );
+    }
     if args.partition.is_some() {
         miette::bail!(
             "{what} cannot be used with --partition: a partition holds sums for `radiant merge`; \
