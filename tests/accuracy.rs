@@ -114,9 +114,10 @@ fn max_depth_2_is_reported_as_biased() {
     };
     for c in &report.curves {
         eprintln!(
-            "{}: z² {:.2}",
+            "{}: z² {:.2} (threshold {:.2})",
             c.setting.label(),
-            c.last().unwrap().bias.block_z2
+            c.last().unwrap().bias.block_z2,
+            c.last().unwrap().bias.threshold
         );
     }
     assert!(by_label("max_depth=2").is_biased());
@@ -153,14 +154,14 @@ fn csv_plot_and_summary_are_written_and_parse() {
         assert_eq!(fields.len(), columns, "{line}");
         let spp: u32 = fields[3].parse().unwrap();
         assert!(spp >= 2);
-        for f in &fields[4..12] {
+        for f in &fields[4..14] {
             let v: f64 = f.parse().unwrap_or_else(|_| panic!("not a number: {f}"));
             assert!(v.is_finite());
         }
-        for f in &fields[12..] {
+        for f in &fields[14..] {
             assert!(matches!(*f, "true" | "false"), "{f}");
         }
-        pareto += (fields[13] == "true") as usize;
+        pareto += (fields[15] == "true") as usize;
         rows += 1;
     }
     let expected: usize = report.curves.iter().map(|c| c.points.len()).sum();
@@ -184,7 +185,7 @@ fn csv_plot_and_summary_are_written_and_parse() {
     let png = image::open(dir.path().join(accuracy::PLOT_FILE))
         .unwrap()
         .to_rgb8();
-    assert_eq!(png.dimensions(), (960, 640));
+    assert_eq!(png.dimensions(), (1240, 640));
     let colours: std::collections::HashSet<[u8; 3]> = png.pixels().map(|p| p.0).collect();
     assert!(colours.len() > 20, "the plot has {} colours", colours.len());
 
@@ -226,4 +227,76 @@ fn progressive_passes_add_up_to_one_render() {
         whole.pixels,
         vec![radiant::core::Rgb::ZERO; whole.pixels.len()]
     );
+}
+
+#[test]
+fn quasi_random_samplers_are_not_called_biased_and_verdicts_match_shares() {
+    let mut c = config(&[Axis::Sampler, Axis::MaxDepth]);
+    c.max_spp = 64;
+    let report = sweep(&c);
+    for curve in &report.curves {
+        let last = curve.last().unwrap();
+        eprintln!(
+            "{}: z² {:.2} (threshold {:.2}), share {:.2}",
+            curve.setting.label(),
+            last.bias.block_z2,
+            last.bias.threshold,
+            last.bias.bias_share()
+        );
+        // The verdict and the figure are one number: a share above zero
+        // exactly where the setting is called biased.
+        assert_eq!(curve.is_biased(), last.bias.bias_share() > 0.0);
+        let sampler = curve.setting.label().starts_with("sampler=");
+        assert!(
+            !(sampler && curve.is_biased()),
+            "{} called biased",
+            curve.setting.label()
+        );
+    }
+    let depth2 = report
+        .curves
+        .iter()
+        .find(|c| c.setting.label() == "max_depth=2")
+        .unwrap();
+    assert!(depth2.is_biased() && depth2.last().unwrap().bias.bias_share() > 0.5);
+}
+
+#[test]
+fn the_budget_bounds_the_whole_run_reference_included() {
+    let budget = Duration::from_secs(4);
+    let c = Config {
+        budget,
+        reference_time: budget / 4,
+        max_spp: 1 << 16,
+        axes: vec![Axis::MaxDepth],
+        overrides: Overrides {
+            width: Some(SIZE),
+            height: Some(SIZE),
+            ..Default::default()
+        },
+        seed: 3,
+    };
+    let start = std::time::Instant::now();
+    let report = accuracy::run(
+        &mut scene(),
+        &radiant::builtin_registry(),
+        &c,
+        None,
+        &|line| eprintln!("{line}"),
+    )
+    .unwrap();
+    let wall = start.elapsed();
+    // A pass is cut to what its predicted cost leaves; the slack is one
+    // pass of a 32×32 film and its metrics, on a busy machine.
+    assert!(
+        wall <= budget + Duration::from_millis(1500),
+        "{wall:?} for a budget of {budget:?}"
+    );
+    assert!(report.total_time <= wall);
+    // The time was used: the reference and the settings rendered more
+    // than their first passes.
+    assert!(report.reference.spp.unwrap() > 2);
+    let points: usize = report.curves.iter().map(|c| c.points.len()).sum();
+    assert!(points > report.curves.len(), "{points} points");
+    assert!(wall >= budget.mul_f64(0.6), "{wall:?}");
 }

@@ -7,17 +7,36 @@
 //! noise: for independent halves A and B of equal variance, the image
 //! I = (A + B)/2 has Var(I) = E[(A − B)²]/4. What the mean squared error
 //! has beyond the variances of the image and of the reference is bias.
+//!
+//! The bias test works on block means, where noise averages out and bias
+//! does not. Per block, D = mean(I − R) and H = mean((A − B)/2 +
+//! (R_A − R_B)/2) have the same variance when the halves are independent
+//! and alike — whatever the sampler (independent or quasi-random), the
+//! pixel filter's correlation of neighbours or the shape of the noise — so
+//! E[D²] = Var + bias² while E[H²] = Var. The test statistic z² is
+//! Σ w·D² / Σ w·H², each block weighted by the inverse of its pixels' noise
+//! (w = 1/Σ h², h the per-pixel half differences), so that a few noisy
+//! blocks (fireflies) do not outweigh the rest; the threshold comes from the
+//! effective number of blocks of the weighted ΣH². The share
+//! of bias it reports, 1 − threshold/z², is the part of the block-mean
+//! differences that noise cannot explain at the test's confidence: above
+//! zero exactly when the setting is called biased.
 
 use crate::compare::compare;
 use crate::film::Image;
 use crate::film::output::to_srgb8;
 
-/// Smallest block edge of the bias test: enough pixels per block for its
-/// variance estimate to be steady.
+/// Smallest block edge of the bias test: enough pixels per block for the
+/// block means to average noise.
 const MIN_BLOCK: u32 = 8;
 
-/// Median of the χ² distribution with one degree of freedom.
-const CHI2_1_MEDIAN: f64 = 0.454_936_4;
+/// One-sided normal quantile of the bias test: a false "biased" about once
+/// in 4000 unbiased measurements (for Gaussian block means).
+const BIAS_TEST_Z: f64 = 3.5;
+
+/// Smallest threshold of the bias test's ratio, for images with so many
+/// blocks that a bias far below the noise would be flagged.
+const MIN_BIAS_THRESHOLD: f64 = 1.25;
 
 /// How far an image is from the reference.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -134,22 +153,60 @@ pub struct BiasSplit {
     /// squared bias per pixel and channel (may come out slightly negative
     /// for an unbiased setting).
     pub bias2: f64,
-    /// Mean over pixel blocks of the squared block-mean difference divided
-    /// by its expected value without bias: about 1 for an unbiased setting,
-    /// far above 1 for a biased one.
+    /// Σ D² / Σ H² over pixel blocks: the squared block-mean differences
+    /// from the reference over what the halves say noise alone gives
+    /// (see the module's documentation): about 1 without bias.
     pub block_z2: f64,
+    /// The value of [`block_z2`](Self::block_z2) above which the setting is
+    /// called biased, for the effective number of blocks of ΣH².
+    pub threshold: f64,
+}
+
+impl BiasSplit {
+    /// The share of bias in the block-mean differences from the reference
+    /// that noise cannot explain at the test's confidence,
+    /// 1 − threshold/z² (0 within the noise): above 0 exactly when
+    /// [`is_biased`](Self::is_biased).
+    pub fn bias_share(&self) -> f64 {
+        if self.block_z2 > self.threshold {
+            1.0 - self.threshold / self.block_z2
+        } else {
+            0.0
+        }
+    }
+
+    /// Whether the block means differ from the reference beyond their
+    /// noise.
+    pub fn is_biased(&self) -> bool {
+        self.block_z2 > self.threshold
+    }
+}
+
+/// The threshold of the ratio test over `blocks` effective blocks: ln of a
+/// ratio of two χ²ₙ/n has variance about 4/n, so exp(z·2/√n), at least
+/// [`MIN_BIAS_THRESHOLD`].
+pub fn bias_threshold(blocks: f64) -> f64 {
+    (BIAS_TEST_Z * 2.0 / blocks.max(1.0).sqrt())
+        .exp()
+        .max(MIN_BIAS_THRESHOLD)
+}
+
+/// Kish's effective number of terms of a sum of non-negative `terms`:
+/// (Σ t)² / Σ t², the count of equal terms that would spread as much.
+fn effective_count(terms: impl Iterator<Item = f64> + Clone) -> f64 {
+    let sum: f64 = terms.clone().sum();
+    let squares: f64 = terms.map(|t| t * t).sum();
+    if squares > 0.0 {
+        sum * sum / squares
+    } else {
+        1.0
+    }
 }
 
 /// Splits the error of `image` (given as halves) against `reference` (with
 /// its halves if it was rendered here, or `None` for an outside reference
-/// assumed noise-free) into variance and bias.
-///
-/// The bias test compares, over blocks of 1/16 of the image's smaller side
-/// (at least 8 pixels), the mean difference of each block with the spread of
-/// that difference expected from the halves: the variance of a block mean
-/// is estimated from the per-pixel variances scaled by one factor for the
-/// whole image (pixel filters correlate neighbours), the median over blocks
-/// of the squared block-mean half difference over that estimate.
+/// assumed noise-free) into variance and bias, and tests for bias over
+/// blocks of 1/16 of the image's smaller side (at least 8 pixels).
 pub fn bias_split(
     image: Halves<'_>,
     reference: &Image,
@@ -170,55 +227,56 @@ pub fn bias_split(
     let block = (w.min(h) / 16).max(MIN_BLOCK);
     let (bw, bh) = (w.div_ceil(block), h.div_ceil(block));
     let nb = (bw * bh) as usize;
-    // Per block: Σ (I − R), Σ half differences, Σ per-pixel variances, count.
-    let mut d = vec![0.0f64; nb];
-    let mut half = vec![0.0f64; nb];
-    let mut pixel_var = vec![0.0f64; nb];
+    // Per block and channel: Σ (I − R), Σ half differences, and the count.
+    let mut d = vec![[0.0f64; 3]; nb];
+    let mut half = vec![[0.0f64; 3]; nb];
     let mut count = vec![0u32; nb];
-    let mean3 = |v: radiant_core::Rgb| (v.x + v.y + v.z) as f64 / 3.0;
+    let mut pixel_var = vec![0.0f64; nb];
     for y in 0..h {
         for x in 0..w {
             let i = (y * w + x) as usize;
             let b = ((y / block) * bw + x / block) as usize;
-            d[b] += mean3(combined.pixels[i] - reference.pixels[i]);
-            let hi = mean3(image.a.pixels[i] - image.b.pixels[i]) / 2.0;
-            let hr = ref_halves.map_or(0.0, |r| mean3(r.a.pixels[i] - r.b.pixels[i]) / 2.0);
-            half[b] += hi + hr;
-            pixel_var[b] += hi * hi + hr * hr;
+            let di = combined.pixels[i] - reference.pixels[i];
+            let hi = (image.a.pixels[i] - image.b.pixels[i]) * 0.5;
+            let hr = ref_halves.map_or(radiant_core::Rgb::ZERO, |r| {
+                (r.a.pixels[i] - r.b.pixels[i]) * 0.5
+            });
+            for c in 0..3 {
+                d[b][c] += di[c] as f64;
+                half[b][c] += (hi[c] + hr[c]) as f64;
+                pixel_var[b] += (hi[c] as f64).powi(2) + (hr[c] as f64).powi(2);
+            }
             count[b] += 1;
         }
     }
-    let mut ratios = Vec::with_capacity(nb);
-    for b in 0..nb {
-        let c = count[b] as f64;
-        d[b] /= c;
-        half[b] /= c;
-        pixel_var[b] /= c * c;
-        if pixel_var[b] > 0.0 {
-            ratios.push(half[b] * half[b] / pixel_var[b]);
-        }
-    }
-    // Each ratio is about correlation × χ²₁, whose median is 0.4549: the
-    // median makes the factor robust to a few blocks of extreme noise.
-    let correlation = if ratios.is_empty() {
-        1.0
-    } else {
-        let mid = ratios.len() / 2;
-        let (_, median, _) = ratios.select_nth_unstable_by(mid, f64::total_cmp);
-        (*median / CHI2_1_MEDIAN).max(1.0)
+    // Per block, the squared block means summed over the channels, each
+    // weighted by the inverse of its pixels' summed squared half
+    // differences (blocks without noise are left out).
+    let weighted = |sums: &[[f64; 3]]| -> Vec<f64> {
+        sums.iter()
+            .zip(&count)
+            .zip(&pixel_var)
+            .filter(|(_, v)| **v > 0.0)
+            .map(|((s, &c), v)| {
+                let m2: f64 = s.iter().map(|x| (x / f64::from(c.max(1))).powi(2)).sum();
+                m2 / v
+            })
+            .collect()
     };
-    let (mut z2, mut used) = (0.0, 0usize);
-    for b in 0..nb {
-        let v = correlation * pixel_var[b];
-        if v > 0.0 {
-            z2 += d[b] * d[b] / v;
-            used += 1;
-        }
-    }
+    let (d2, h2) = (weighted(&d), weighted(&half));
+    let (sd, sh): (f64, f64) = (d2.iter().sum(), h2.iter().sum());
+    let block_z2 = if sh > 0.0 {
+        sd / sh
+    } else if sd > 0.0 {
+        f64::INFINITY
+    } else {
+        1.0
+    };
     BiasSplit {
         variance,
         bias2: mse - variance - ref_variance,
-        block_z2: if used > 0 { z2 / used as f64 } else { 0.0 },
+        block_z2,
+        threshold: bias_threshold(effective_count(h2.iter().copied())),
     }
 }
 
@@ -325,11 +383,37 @@ mod tests {
                 (0.75..1.3).contains(&unbiased.block_z2),
                 "blur {blur}: {unbiased:?}"
             );
+            assert!(!unbiased.is_biased() && unbiased.bias_share() == 0.0);
             // An offset of half the per-pixel noise is found.
             let sd = unbiased.variance.sqrt() as f32;
             let (a, b) = (noisy(&r, 1, 0.5 * sd, blur), noisy(&r, 2, 0.5 * sd, blur));
             let biased = bias_split(Halves { a: &a, b: &b }, &r, None);
             assert!(biased.block_z2 > 3.0, "blur {blur}: {biased:?}");
+            // The verdict and the share agree: most of the block-mean
+            // difference is the offset.
+            assert!(
+                biased.is_biased() && biased.bias_share() > 0.5,
+                "{biased:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_threshold_falls_with_the_number_of_blocks_and_the_share_agrees() {
+        assert!(bias_threshold(16.0) > bias_threshold(64.0));
+        assert!(bias_threshold(64.0) > bias_threshold(10_000.0));
+        assert_eq!(bias_threshold(1e6), MIN_BIAS_THRESHOLD);
+        assert_eq!(effective_count([2.0, 2.0, 2.0, 2.0].into_iter()), 4.0);
+        // One term carrying nearly everything counts about once.
+        assert!(effective_count([100.0, 0.1, 0.1, 0.1].into_iter()) < 1.01);
+        for z2 in [0.5, 1.0, 1.4, 1.5, 1.6, 3.0, 50.0] {
+            let s = BiasSplit {
+                variance: 1.0,
+                bias2: 0.0,
+                block_z2: z2,
+                threshold: 1.5,
+            };
+            assert_eq!(s.is_biased(), s.bias_share() > 0.0, "{z2}");
         }
     }
 }

@@ -81,10 +81,12 @@ pub enum AccuracyError {
 /// What to sweep and within which limits.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Config {
-    /// Wall-time bound of the whole sweep (the reference render excluded);
-    /// each setting gets an equal share.
+    /// Wall-time bound of the whole run: the reference render (when none
+    /// is given) and then the sweep, whose settings share what is left.
     pub budget: Duration,
-    /// Time for rendering the reference when none is given.
+    /// The part of the budget for rendering the reference when none is
+    /// given (the sweep gets at least the rest; a reference time beyond
+    /// the budget leaves the sweep nothing but each setting's first pass).
     pub reference_time: Duration,
     /// Largest samples per pixel of a setting (both halves together); the
     /// reference may use 16 times as many.
@@ -98,11 +100,11 @@ pub struct Config {
 }
 
 impl Config {
-    /// Every axis within `budget`, the reference rendered for as long.
+    /// Every axis within `budget`, a quarter of it for the reference.
     pub fn new(budget: Duration) -> Self {
         Self {
             budget,
-            reference_time: budget,
+            reference_time: budget / REFERENCE_SHARE,
             max_spp: 1 << 16,
             axes: Axis::ALL.to_vec(),
             overrides: Overrides::default(),
@@ -110,6 +112,9 @@ impl Config {
         }
     }
 }
+
+/// The reference's share of the budget by default: 1/4.
+pub const REFERENCE_SHARE: u32 = 4;
 
 /// The measured sweep.
 #[derive(Debug, Clone)]
@@ -126,11 +131,13 @@ pub struct Report {
     pub budget: Duration,
     /// Wall time of the sweep (reference excluded).
     pub sweep_time: Duration,
+    /// Wall time of the whole run (reference render included).
+    pub total_time: Duration,
 }
 
 /// Measures every setting of `config.axes` on `scene` against `reference`
-/// (or a reference rendered first when `None`); `log` receives a line per
-/// finished step.
+/// (or a reference rendered first when `None`), all within
+/// `config.budget`; `log` receives a line per finished step.
 pub fn run(
     scene: &mut Scene,
     registry: &Registry,
@@ -138,6 +145,7 @@ pub fn run(
     reference: Option<Reference>,
     log: &dyn Fn(&str),
 ) -> Result<Report, AccuracyError> {
+    let started = Instant::now();
     let reference = match reference {
         Some(r) => r,
         None => {
@@ -163,7 +171,7 @@ pub fn run(
     for (i, setting) in settings.iter().enumerate() {
         // Spread what is left of the budget over the settings still to run,
         // so that one that ends early leaves its time to the others.
-        let left = config.budget.saturating_sub(start.elapsed());
+        let left = config.budget.saturating_sub(started.elapsed());
         let share = left / (settings.len() - i) as u32;
         let limits = sweep::RunLimits {
             share,
@@ -197,6 +205,7 @@ pub fn run(
         notes,
         budget: config.budget,
         sweep_time: start.elapsed(),
+        total_time: started.elapsed(),
     })
 }
 

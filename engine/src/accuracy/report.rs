@@ -6,12 +6,6 @@ use super::Report;
 use super::sweep::{Curve, Measurement};
 use std::fmt::Write;
 
-/// A setting is reported as biased when, at its last measurement, the
-/// block means differ from the reference by more than this many times
-/// their expected noise variance (about 1 without bias; see
-/// [`BiasSplit::block_z2`](super::metrics::BiasSplit::block_z2)).
-pub const BIAS_Z2_THRESHOLD: f64 = 3.0;
-
 /// Least-squares slope of ln y against ln x (`None` with fewer than two
 /// distinct positive points).
 pub fn log_log_slope(points: impl IntoIterator<Item = (f64, f64)>) -> Option<f64> {
@@ -56,10 +50,10 @@ impl Curve {
         self.points.last()
     }
 
-    /// Whether the last measurement shows bias beyond its noise.
+    /// Whether the last measurement shows bias beyond its noise (see
+    /// [`BiasSplit::is_biased`](super::metrics::BiasSplit::is_biased)).
     pub fn is_biased(&self) -> bool {
-        self.last()
-            .is_some_and(|m| m.bias.block_z2 > BIAS_Z2_THRESHOLD)
+        self.last().is_some_and(|m| m.bias.is_biased())
     }
 
     /// RMSE at time `t`, interpolated log-log between measurements; `None`
@@ -127,8 +121,7 @@ pub fn best_within(curves: &[Curve], t: f64) -> Option<(usize, usize)> {
 }
 
 /// The CSV header; [`csv`] writes one row per measurement in this order.
-pub const CSV_HEADER: &str =
-    "setting,axis,value,spp,time_s,rmse,rel_mse,mae,flip,variance,bias2,bias_z2,biased,pareto";
+pub const CSV_HEADER: &str = "setting,axis,value,spp,time_s,rmse,rel_mse,mae,flip,variance,bias2,bias_z2,bias_threshold,bias_share,biased,pareto";
 
 /// Every measurement as CSV (labels contain no commas or quotes).
 pub fn csv(report: &Report) -> String {
@@ -140,7 +133,7 @@ pub fn csv(report: &Report) -> String {
         for (p, m) in curve.points.iter().enumerate() {
             let _ = writeln!(
                 out,
-                "{},{},{},{},{:.6},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.4},{},{}",
+                "{},{},{},{},{:.6},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.4},{:.4},{:.4},{},{}",
                 s.label(),
                 s.axis,
                 s.value(),
@@ -153,7 +146,9 @@ pub fn csv(report: &Report) -> String {
                 m.bias.variance,
                 m.bias.bias2,
                 m.bias.block_z2,
-                curve.is_biased(),
+                m.bias.threshold,
+                m.bias.bias_share(),
+                m.bias.is_biased(),
                 front.contains(&(c, p)),
             );
         }
@@ -188,11 +183,12 @@ pub fn summary(report: &Report) -> String {
     };
     let _ = writeln!(
         md,
-        "Sweep: {} settings in {:.1} s (budget {:.1} s), CPU backend (`backend=gpu`: the GPU \
-         backend), {}×{} pixels. Time is extract (BVH build included) plus rendering, measured \
-         on this machine.\n",
+        "Sweep: {} settings in {:.1} s ({:.1} s with the reference; budget {:.1} s for both), \
+         CPU backend (`backend=gpu`: the GPU backend), {}×{} pixels. Time is extract (BVH build \
+         included) plus rendering, measured on this machine.\n",
         curves.len(),
         report.sweep_time.as_secs_f64(),
+        report.total_time.as_secs_f64(),
         report.budget.as_secs_f64(),
         r.image.width,
         r.image.height
@@ -246,8 +242,12 @@ pub fn summary(report: &Report) -> String {
         md,
         "Last measurement of each setting; RMSE at equal time is at {equal_time:.3} s, the \
          time every setting reached. Slopes are of log RMSE against log time and log spp \
-         (−0.5: unbiased Monte Carlo; the reference's noise taken out). Bias share is bias² over MSE (shown for biased settings); z² compares block-mean \
-         differences with their noise (≈ 1 unbiased, > {BIAS_Z2_THRESHOLD} flagged).\n"
+         (−0.5: unbiased Monte Carlo; the reference's noise taken out). z² is the mean square of \
+         the block-mean differences from the reference over that of the block-mean half \
+         differences (what noise alone gives): ≈ 1 unbiased, flagged above its threshold \
+         (from the effective number of blocks; shown after the slash). Bias share is \
+         1 − threshold/z², the part of the block-mean differences that noise cannot explain \
+         (0 unless flagged).\n"
     );
     let _ = writeln!(
         md,
@@ -256,10 +256,9 @@ pub fn summary(report: &Report) -> String {
     );
     for c in curves {
         let Some(m) = c.last() else { continue };
-        let mse = m.metrics.rmse * m.metrics.rmse;
         let _ = writeln!(
             md,
-            "| {} | {} | {:.3} | {:.4e} | {:.4e} | {:.4e} | {:.4} | {} | {} | {} | {} | {:.2} | {} |",
+            "| {} | {} | {:.3} | {:.4e} | {:.4e} | {:.4e} | {:.4} | {} | {} | {} | {:.0} % | {:.2} / {:.2} | {} |",
             c.setting.label(),
             m.spp,
             m.time,
@@ -270,12 +269,9 @@ pub fn summary(report: &Report) -> String {
             opt(c.rmse_at(equal_time), |v| format!("{v:.4e}")),
             opt(c.slope_time(), |v| format!("{v:.2}")),
             opt(c.slope_spp(), |v| format!("{v:.2}")),
-            if c.is_biased() {
-                format!("{:.0} %", 100.0 * (m.bias.bias2 / mse).clamp(0.0, 1.0))
-            } else {
-                "–".to_string()
-            },
+            100.0 * m.bias.bias_share(),
             m.bias.block_z2,
+            m.bias.threshold,
             if c.is_biased() { "**yes**" } else { "no" }
         );
     }
@@ -359,6 +355,7 @@ mod tests {
                 variance: rmse * rmse,
                 bias2: 0.0,
                 block_z2: 1.0,
+                threshold: 2.0,
             },
         }
     }
@@ -417,7 +414,7 @@ mod tests {
     fn bias_flag_follows_the_last_measurement() {
         let mut c = curve(2, &[(1.0, 1.0), (2.0, 0.9)]);
         assert!(!c.is_biased());
-        c.points[1].bias.block_z2 = BIAS_Z2_THRESHOLD * 1.5;
+        c.points[1].bias.block_z2 = 3.0;
         assert!(c.is_biased());
         c.points[0].bias.block_z2 = 100.0;
         c.points[1].bias.block_z2 = 1.0;

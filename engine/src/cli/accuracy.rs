@@ -19,10 +19,12 @@ pub struct AccuracyArgs {
     /// reference of the scene as written is rendered first.
     #[arg(long)]
     reference: Option<PathBuf>,
-    /// Wall-time bound of the sweep in seconds (the reference render excluded).
+    /// Wall-time bound of the whole run in seconds: the reference render
+    /// (when no --reference is given) and the sweep, which shares the rest.
     #[arg(long, default_value_t = 60.0, allow_negative_numbers = true)]
     budget: f64,
-    /// Time for rendering the reference in seconds (default: the budget).
+    /// The part of the budget for rendering the reference, in seconds
+    /// (default: a quarter of the budget); less than the budget.
     #[arg(long, allow_negative_numbers = true)]
     reference_time: Option<f64>,
     /// Folder for accuracy.csv, accuracy.png, accuracy.md and reference.exr.
@@ -81,8 +83,16 @@ pub fn run(registry: &Registry, args: &AccuracyArgs) -> miette::Result<()> {
     let budget = seconds("budget", args.budget)?;
     let reference_time = match args.reference_time {
         Some(t) => seconds("reference-time", t)?,
-        None => budget,
+        None => budget / accuracy::REFERENCE_SHARE,
     };
+    if args.reference.is_none() && reference_time >= budget {
+        miette::bail!(
+            "--reference-time ({:.1} s) must be less than --budget ({:.1} s): the budget covers \
+             the reference render and the sweep",
+            reference_time.as_secs_f64(),
+            budget.as_secs_f64()
+        );
+    }
     if args.max_spp < 2 {
         miette::bail!("--max-spp must be at least 2 (each setting renders two halves)");
     }
@@ -114,9 +124,11 @@ pub fn run(registry: &Registry, args: &AccuracyArgs) -> miette::Result<()> {
     let result = result.map_err(error)?;
     accuracy::write(&result, &args.out).map_err(error)?;
     eprintln!(
-        "sweep of {} settings took {:.1} s; wrote {}, {} and {} in {}",
+        "sweep of {} settings took {:.1} s ({:.1} s with the reference, budget {:.1} s); wrote {}, {} and {} in {}",
         result.curves.len(),
         result.sweep_time.as_secs_f64(),
+        result.total_time.as_secs_f64(),
+        budget.as_secs_f64(),
         accuracy::CSV_FILE,
         accuracy::PLOT_FILE,
         accuracy::SUMMARY_FILE,
