@@ -28,8 +28,8 @@ mod gltf;
 mod instances;
 mod keyframes;
 pub mod line_limit;
-pub mod mesh;
 pub mod media;
+pub mod mesh;
 pub mod normals;
 pub mod obj;
 pub mod ply;
@@ -69,9 +69,9 @@ const TOP_KEYS: &[&str] = &[
     "shapes",
     "lights",
     "animation",
-];
     "media",
     "atmosphere",
+];
 const SHAPE_TYPES: &[&str] = &["rectangle", "cube", "sphere", "mesh", "gltf"];
 const INTEGRATORS: &[&str] = &["path"];
 
@@ -93,9 +93,9 @@ struct Loader<'f> {
     keyframes: KeyframeReader<'f>,
     materials: Vec<(String, ModuleSpec)>,
     material_ids: HashMap<String, u32>,
-    /// Deforming meshes whose first frame is read once the frame range is
     /// The scene's media and the interfaces shapes put between them.
     media: media::SceneMedia,
+    /// Deforming meshes whose first frame is read once the frame range is
     /// known: (entity, pattern, where `filename` was written).
     sequences: Vec<(hecs::Entity, PendingSequence)>,
     /// Textures that glTF materials define, added to `textures:`.
@@ -120,8 +120,8 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
         keyframes: KeyframeReader::new(file, fps),
         materials: named_modules(file, top.get("materials"), "material")?,
         material_ids: HashMap::new(),
-        sequences: Vec::new(),
         media: media::SceneMedia::parse(file, top.get("media"), top.get("atmosphere"))?,
+        sequences: Vec::new(),
         textures: Vec::new(),
     };
     loader.material_ids = loader
@@ -204,8 +204,8 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
         sampler,
         textures,
         materials: loader.materials,
-    };
         media: loader.media,
+    };
     crate::world::systems::animate(&mut scene, timeline.start)?;
     Ok(scene)
 }
@@ -301,10 +301,10 @@ impl Loader<'_> {
         )?;
         self.keyframes.module_tracks(&mut module)?;
         let map = node.as_mapping().expect("from_node checked the mapping");
-        let (look, transform, animation) = (
         if let Some(medium) = map.get_node("medium") {
             self.media.camera = self.media.reference(file, Some(medium))?;
         }
+        let (look, transform, animation) = (
             map.get_node("look_at"),
             map.get_node("transform"),
             map.get_node("animation"),
@@ -977,13 +977,13 @@ fn parse_shape(loader: &mut Loader<'_>, node: &Node, index: usize) -> Result<Sha
         "flip_normals",
         "animation",
         "instances",
-    ];
         "interior",
         "exterior",
+    ];
     keys.extend_from_slice(allowed);
-    map.finish(&keys)?;
     // Read by the media (`media.rs`) once the geometry is known.
     let _ = (map.get("interior"), map.get("exterior"));
+    map.finish(&keys)?;
     let sphere = matches!(geometry, Geometry::Sphere);
     if let (true, true, Some(node)) = (sphere, flip_normals, flip_node) {
         return Err(SceneError::new(
@@ -999,11 +999,11 @@ fn parse_shape(loader: &mut Loader<'_>, node: &Node, index: usize) -> Result<Sha
             "a sphere's transform may only rotate, translate and scale uniformly",
         ));
     }
-    Ok(ShapeDef {
     let material = match loader.media.interface(file, node, &geometry)? {
         Some(interface) => loader.bound_medium(material, interface, flip_normals, &name),
         None => material,
     };
+    Ok(ShapeDef {
         name: Name(name),
         transform,
         geometry,
