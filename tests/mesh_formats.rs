@@ -26,13 +26,13 @@ const MESH_LINE: &str = "filename: torus.obj";
 const MATERIAL: &str = "material: {type: diffuse, reflectance: [0.7, 0.7, 0.7]}";
 
 /// Renders the smooth-normal scene with `filename: torus.obj` replaced by
-/// `mesh` (more keys may follow the file name; a `.gltf` file makes the
-/// shape a `gltf` one) at `spp`.
+/// `mesh` (more keys may follow the file name; a `.gltf` or `.glb` file
+/// makes the shape a `gltf` one) at `spp`.
 fn render_with(mesh: &str, textured: bool, spp: u32) -> Image {
     let edit = |text: &str| {
         assert!(text.contains(MESH_LINE) && text.contains(MATERIAL));
         let mut text = text.replace(MESH_LINE, mesh);
-        if mesh.contains(".gltf") {
+        if mesh.contains(".gltf") || mesh.contains(".glb") {
             text = text.replace("type: mesh", "type: gltf");
         }
         if textured {
@@ -84,6 +84,7 @@ fn every_format_with_normals_and_uvs_renders_the_same_image() {
         "filename: torus-uv-le.ply",
         "filename: torus-uv-be.ply",
         "filename: torus-uv.gltf",
+        "filename: torus-uv.glb",
     ];
     for file in files {
         let image = render_with(file, true, 4);

@@ -10,7 +10,7 @@ Writes into ``tests/data/meshes/``:
 2. ``torus-ascii.ply``, ``torus-le.ply``, ``torus-be.ply``: the same torus
    as ASCII and binary little- and big-endian PLY.
 3. ``torus-uv.obj``, ``torus-uv-ascii.ply``, ``torus-uv-le.ply``,
-   ``torus-uv-be.ply``, ``torus-uv.gltf``: the torus with its own vertex
+   ``torus-uv-be.ply``, ``torus-uv.gltf``, ``torus-uv.glb``: the torus with its own vertex
    normals and texture coordinates in each format (OBJ's v up the image,
    PLY's and glTF's down it, as each format's readers expect), for the test
    that every format renders the same image.
@@ -120,9 +120,10 @@ def write_ply(path, verts, tris, attributes, encoding):
                 f.write(struct.pack(e + "Biii", 3, *t))
 
 
-def write_gltf(path, verts, tris):
+def write_gltf(path, verts, tris, glb=False):
     """One mesh, one node, normals and texture coordinates, the buffer
-    embedded as a data URI."""
+    embedded as a data URI (or, with ``glb``, as the binary chunk of a GLB
+    file)."""
     pos = b"".join(struct.pack("<3f", *p) for p, _, _ in verts)
     nrm = b"".join(struct.pack("<3f", *n) for _, n, _ in verts)
     uvs = b"".join(struct.pack("<2f", *uv) for _, _, uv in verts)
@@ -151,6 +152,16 @@ def write_gltf(path, verts, tris):
         "buffers": [{"byteLength": len(data),
                      "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
     }
+    if glb:
+        del doc["buffers"][0]["uri"]
+        text = json.dumps(doc).encode()
+        text += b" " * (-len(text) % 4)
+        data += b"\0" * (-len(data) % 4)
+        chunks = (struct.pack("<II", len(text), 0x4E4F534A) + text
+                  + struct.pack("<II", len(data), 0x004E4942) + data)
+        with open(path, "wb") as f:
+            f.write(struct.pack("<III", 0x46546C67, 2, 12 + len(chunks)) + chunks)
+        return
     with open(path, "w") as f:
         json.dump(doc, f, indent=1)
         f.write("\n")
@@ -274,6 +285,7 @@ def main():
         write_ply(os.path.join(DIR, f"torus-{name}.ply"), verts, tris, False, encoding)
         write_ply(os.path.join(DIR, f"torus-uv-{name}.ply"), verts, tris, True, encoding)
     write_gltf(os.path.join(DIR, "torus-uv.gltf"), verts, tris)
+    write_gltf(os.path.join(DIR, "torus-uv.glb"), verts, tris, glb=True)
     write_png(os.path.join(DIR, "checks.png"))
     write_scene_gltf(os.path.join(DIR, "scene.gltf"), os.path.join(DIR, "torus-uv.gltf"))
     with open(os.path.join(DIR, "smooth.yaml"), "w") as f:

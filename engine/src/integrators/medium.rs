@@ -107,7 +107,8 @@ impl MediumState {
     /// (sampler dimensions `dim`, `dim + 1`); paths that scatter before
     /// their hit get a medium interaction in `its`, leave `live` and are
     /// listed in [`MediumState::events`]. Throughputs take the free-flight
-    /// weights (σs·T/pdf for events, T/P(pass) for the rest).
+    /// weights (σs·T/pdf for events, T/P(pass) for the rest); events add
+    /// the medium's emission, β·σa·Le·T/pdf, to `radiance`.
     #[allow(clippy::too_many_arguments)]
     pub fn sample_distances(
         &mut self,
@@ -117,7 +118,7 @@ impl MediumState {
         ids: &[SampleId],
         ray: (&[Vec3], &[Vec3]),
         hits: &[Hit],
-        beta: &mut [Rgb],
+        (beta, radiance): (&mut [Rgb], &mut [Rgb]),
         its: &mut [Interaction],
     ) {
         let (origin, dir) = ray;
@@ -152,6 +153,7 @@ impl MediumState {
             };
             let flight = free_flight(c.sigma_t(), self.u_channel[k], self.u_distance[k], t_max);
             if flight.scattered {
+                radiance[i] += beta[i] * flight.weight * c.sigma_a * c.emission;
                 beta[i] *= flight.weight * c.sigma_s;
                 if beta[i].max_element() <= 0.0 {
                     continue;

@@ -439,7 +439,7 @@ impl Wavefront {
                     &self.ids,
                     (&self.origin, &self.dir),
                     &self.hit,
-                    &mut self.beta,
+                    (&mut self.beta, &mut self.radiance),
                     &mut self.its,
                 );
             }

@@ -22,6 +22,9 @@ pub struct Coefficients {
     pub sigma_a: Rgb,
     /// σs: scattering.
     pub sigma_s: Rgb,
+    /// Le: emitted radiance, with source term σa·Le per unit length
+    /// (pbrt-v4's convention: an optically thick emitter glows at Le).
+    pub emission: Rgb,
 }
 
 impl Coefficients {
@@ -97,7 +100,8 @@ pub struct FreeFlight {
     /// passes.
     pub t: f32,
     /// Whether the ray interacts with the medium at `t` (else it reaches
-    /// the end of the segment).
+    /// the end of the segment); an interaction also gathers the medium's
+    /// emission, σa·Le times `weight` (the collision estimator).
     pub scattered: bool,
     /// The throughput factor: T(t)/pdf(t) for an interaction (the caller
     /// multiplies by σs and samples the phase function), T(t_max)/P(pass)

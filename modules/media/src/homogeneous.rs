@@ -15,6 +15,7 @@ struct HomogeneousParams {
     albedo: Option<Spanned<Color>>,
     density: Option<Spanned<Color>>,
     scale: Option<Spanned<f32>>,
+    emission: Option<Spanned<Color>>,
 }
 
 const DOCS: &[ParamDoc] = &[
@@ -48,6 +49,12 @@ const DOCS: &[ParamDoc] = &[
         default: "1",
         doc: "Multiplies all coefficients (a unit change).",
     },
+    ParamDoc {
+        name: "emission",
+        ty: "rgb | number, ≥ 0, W/(m²·sr)",
+        default: "0",
+        doc: "Emitted radiance Le (source σa·Le): glowing fog; an optically thick emitter shows Le.",
+    },
 ];
 
 /// A medium with constant coefficients (Mitsuba 3's `homogeneous`).
@@ -57,10 +64,15 @@ pub struct Homogeneous {
 }
 
 impl Homogeneous {
-    /// A medium of absorption `sigma_a` and scattering `sigma_s`.
-    pub fn new(sigma_a: Rgb, sigma_s: Rgb) -> Self {
+    /// A medium of absorption `sigma_a`, scattering `sigma_s` and emitted
+    /// radiance `emission`.
+    pub fn new(sigma_a: Rgb, sigma_s: Rgb, emission: Rgb) -> Self {
         Self {
-            coefficients: Coefficients { sigma_a, sigma_s },
+            coefficients: Coefficients {
+                sigma_a,
+                sigma_s,
+                emission,
+            },
         }
     }
 }
@@ -133,7 +145,8 @@ fn build(params: &Params, _ctx: &mut BuildContext<'_>) -> Result<Homogeneous, Pa
             "the medium's coefficients times `scale` overflow to infinity",
         ));
     }
-    Ok(Homogeneous::new(sigma_a, sigma_s))
+    let emission = checked(&p.emission, "emission", Rgb::ZERO, f32::INFINITY)?;
+    Ok(Homogeneous::new(sigma_a, sigma_s, emission))
 }
 
 pub(crate) fn register(registry: &mut Registry) {
