@@ -108,9 +108,10 @@ fn interrupted(scene: &Path, out: &Path, extra: &[&str]) -> Output {
         assert!(Instant::now() < deadline, "no checkpoint in 120 s");
         std::thread::sleep(Duration::from_millis(20));
     }
-    // A checkpoint is a valid state of fewer samples than asked for.
+    // A checkpoint is a valid image and state of some samples.
     let first = samples_in(out);
     assert!(first >= 1, "{first}");
+    assert!(read(out).mean() > 0.0);
     let kill = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()
