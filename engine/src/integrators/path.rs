@@ -141,9 +141,9 @@ pub struct Wavefront {
     first_hits: Vec<FirstHit>,
     /// The first hits' albedos, per live path in material order.
     albedo_k: Vec<Rgb>,
-    /// Rays traced so far (camera, continuation and shadow rays).
     /// Medium state (only in frames with media; see `integrators/medium.rs`).
     media: MediumState,
+    /// Rays traced so far (camera, continuation and shadow rays).
     pub rays: u64,
 }
 
@@ -410,27 +410,15 @@ impl Wavefront {
         let has_area = scene.effects.contains(Effects::AREA_LIGHTS);
         let has_env = !scene.lights.environment().is_empty();
         let camera_dims = CAMERA_DIMS + u32::from(scene.motion_blur());
-        let mut depth = 0u32;
-        while !self.live.is_empty() {
-            self.trace_closest(scene);
-            self.resolve_hits(scene, depth, has_area, has_env);
-            if has_env {
-                self.add_escaped(scene, depth);
-            }
-            let first_hits = depth == 0 && self.collect_aovs;
-            if depth + 1 >= max_depth && !first_hits {
-                break;
-            }
-            let n = self.sort_by_material(scene);
         let has_media = medium::active(scene);
         let bounce_dims = BOUNCE_DIMS + if has_media { MEDIUM_DIMS } else { 0 };
         if has_media {
             self.media.start(scene, &self.origin[..self.live.len()]);
         }
-            if first_hits {
-                self.record_first_hits(scene, n);
+        let mut depth = 0u32;
+        while !self.live.is_empty() {
             let base = camera_dims + depth * bounce_dims;
-                if depth + 1 >= max_depth {
+            self.trace_closest(scene);
             if has_media {
                 self.media.sample_distances(
                     scene,
@@ -443,28 +431,28 @@ impl Wavefront {
                     &mut self.its,
                 );
             }
-                    break;
+            self.resolve_hits(scene, depth, has_area, has_env);
             if has_media {
                 self.live.extend_from_slice(self.media.events());
             }
+            if has_env {
+                self.add_escaped(scene, depth);
+            }
+            let first_hits = depth == 0 && self.collect_aovs;
+            if depth + 1 >= max_depth && !first_hits {
+                break;
+            }
+            let n = self.sort_by_material(scene);
+            if first_hits {
+                self.record_first_hits(scene, n);
+                if depth + 1 >= max_depth {
+                    break;
                 }
             }
             if has_lights {
                 self.sample_lights(scene, n, base);
             }
             self.shade(scene, base);
-            if has_lights {
-                self.next_event(scene, n);
-            }
-            self.continue_paths(scene, depth, base);
-            depth += 1;
-        }
-    }
-
-    fn trace_closest(&mut self, scene: &RenderScene) {
-        let times = scene.motion_blur().then_some(&self.time[..]);
-        scene
-            .accel
             if has_media {
                 self.media.shade_events(
                     scene,
@@ -476,10 +464,10 @@ impl Wavefront {
                     &mut self.nee_eval,
                 );
             }
-            .intersect_slots(&self.live, &self.origin, &self.dir, times, &mut self.hit);
-        self.rays += self.live.len() as u64;
-    }
-
+            if has_lights {
+                self.next_event(scene, n);
+            }
+            self.continue_paths(scene, depth, base);
             if has_media {
                 self.media.after_bounce(
                     scene,
@@ -489,6 +477,18 @@ impl Wavefront {
                     &mut self.prev_pdf,
                 );
             }
+            depth += 1;
+        }
+    }
+
+    fn trace_closest(&mut self, scene: &RenderScene) {
+        let times = scene.motion_blur().then_some(&self.time[..]);
+        scene
+            .accel
+            .intersect_slots(&self.live, &self.origin, &self.dir, times, &mut self.hit);
+        self.rays += self.live.len() as u64;
+    }
+
     /// Drops paths that escaped (keeping them in `esc_slots` if `has_env`),
     /// resolves hits, adds emission.
     fn resolve_hits(&mut self, scene: &RenderScene, depth: u32, has_area: bool, has_env: bool) {
@@ -551,6 +551,7 @@ impl Wavefront {
         );
         fit(&mut self.em_hits, self.em_slots.len());
         fit(&mut self.em_evals, self.em_slots.len());
+        let has_media = medium::active(scene);
         for (k, &slot) in self.em_slots.iter().enumerate() {
             let i = slot as usize;
             self.em_hits[k] = EmitterHit {
@@ -567,7 +568,6 @@ impl Wavefront {
         for light in 0..nlights {
             let (a, b) = (
                 self.offsets[light] as usize,
-        let has_media = medium::active(scene);
                 self.offsets[light + 1] as usize,
             );
             if a < b {
