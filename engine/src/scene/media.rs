@@ -83,11 +83,6 @@ impl SceneMedia {
         Ok(out)
     }
 
-    /// Whether the scene has any medium in use.
-    pub fn in_use(&self) -> bool {
-        self.camera != NO_MEDIUM || !self.interfaces.is_empty()
-    }
-
     /// The medium named at `node` ([`NO_MEDIUM`] where there is no node).
     pub(crate) fn reference(&self, file: &Path, node: Option<&Node>) -> Result<u32, SceneError> {
         let Some(node) = node else {
