@@ -321,7 +321,8 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
                 )
             });
         }
-        let secs = rendered.time.as_secs_f64();
+        // A resumed render with nothing left renders for no time.
+        let secs = rendered.time.as_secs_f64().max(f64::MIN_POSITIVE);
         let line = format!(
             "rendered {}x{}, {} spp in {:.3} s ({:.2} Msamples/s, {:.2} Mrays/s)",
             settings.width,
