@@ -302,3 +302,49 @@ fn output_defaults_to_the_scene_name_and_options_reach_the_file() {
         assert!(err.contains(says), "{bad:?}: {err}");
     }
 }
+
+#[test]
+fn alpha_is_the_coverage_in_png_and_exr() {
+    let dir = tempfile::tempdir().unwrap();
+    // A sphere in the middle of an empty frame: opaque there, transparent
+    // in the corners.
+    let scene = dir.path().join("ball.yaml");
+    std::fs::write(
+        &scene,
+        "film: {width: 24, height: 24, alpha: true}\n\
+         sampler: {type: independent, spp: 4}\n\
+         camera: {type: perspective, fov: 30, look_at: {origin: [0, 0, 4], target: [0, 0, 0], up: [0, 1, 0]}}\n\
+         materials: {white: {type: diffuse, reflectance: 0.8}}\n\
+         shapes: [{type: sphere, radius: 0.5, material: white}]\n\
+         lights: [{type: point, position: [0, 2, 3], intensity: 20}]\n",
+    )
+    .unwrap();
+    let scene = scene.to_str().unwrap();
+    let o = radiant_in(dir.path(), &["render", scene, "-o", "ball.png"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let png = image::open(dir.path().join("ball.png")).unwrap();
+    assert_eq!(png.color(), image::ColorType::Rgba8);
+    let png = png.to_rgba8();
+    assert_eq!(png.get_pixel(12, 12).0[3], 255);
+    assert_eq!(png.get_pixel(0, 0).0[3], 0);
+    // Edge pixels are partly covered.
+    assert!(png.pixels().any(|p| (1..255).contains(&p.0[3])));
+
+    let o = radiant_in(dir.path(), &["render", scene, "-o", "ball.exr"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let exr = exr::prelude::read_first_rgba_layer_from_file(
+        dir.path().join("ball.exr"),
+        |size, _| vec![[0.0f32; 4]; size.width() * size.height()],
+        |pixels, pos, (r, g, b, a): (f32, f32, f32, f32)| {
+            pixels[pos.y() * 24 + pos.x()] = [r, g, b, a]
+        },
+    )
+    .unwrap();
+    let pixels = &exr.layer_data.channel_data.pixels;
+    assert_eq!(pixels[12 * 24 + 12][3], 1.0);
+    assert_eq!(pixels[0][3], 0.0);
+    // JPEG has no alpha channel: refused.
+    let o = radiant_in(dir.path(), &["render", scene, "-o", "ball.jpg"]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no alpha channel"));
+}

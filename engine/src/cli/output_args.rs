@@ -23,6 +23,11 @@ pub struct OutputArgs {
     /// Write EXR output as 16-bit half floats instead of 32-bit floats.
     #[arg(long)]
     pub half: bool,
+    /// Add the coverage as alpha to PNG (straight) and EXR (premultiplied)
+    /// output: transparent where camera rays hit nothing. Renders the whole
+    /// frame on the CPU.
+    #[arg(long)]
+    pub alpha: bool,
 }
 
 /// A finite number.
@@ -50,6 +55,7 @@ impl OutputArgs {
             exposure: self.exposure,
             bit_depth: self.bit_depth,
             exr: self.half.then_some(ExrSamples::Half),
+            alpha: self.alpha.then_some(true),
         }
     }
 }

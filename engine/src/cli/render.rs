@@ -304,7 +304,8 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
             if let Some(session) = &progressive {
                 let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
                 session.render(args, backend.as_mut(), (s, frame), &path, &progress, &note)
-            } else if args.passes.wanted() {
+            } else if args.passes.wanted() || settings.output.alpha {
+                // Alpha is the coverage plane, which the passes record.
                 let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
                 passes::write(&args.passes, s, &path, &progress, &note)
             } else {

@@ -100,6 +100,9 @@ pub struct Encoding {
     pub exr: ExrSamples,
     /// JPEG quality, 1 to 100.
     pub jpeg_quality: u8,
+    /// Whether PNG and EXR output carry the coverage as alpha
+    /// ([`super::alpha`]).
+    pub alpha: bool,
 }
 
 /// JPEG quality when the scene gives none.
@@ -113,6 +116,7 @@ impl Default for Encoding {
             bit_depth: BitDepth::default(),
             exr: ExrSamples::default(),
             jpeg_quality: DEFAULT_JPEG_QUALITY,
+            alpha: false,
         }
     }
 }
@@ -128,6 +132,8 @@ pub struct OutputOverrides {
     pub bit_depth: Option<BitDepth>,
     /// EXR sample type.
     pub exr: Option<ExrSamples>,
+    /// Alpha in PNG and EXR output.
+    pub alpha: Option<bool>,
 }
 
 /// Equality is that of the fields; an override's exposure is checked to
@@ -145,6 +151,7 @@ impl Encoding {
             tonemap,
             bit_depth: o.bit_depth.unwrap_or(self.bit_depth),
             exr: o.exr.unwrap_or(self.exr),
+            alpha: o.alpha.unwrap_or(self.alpha),
             ..self
         })
     }

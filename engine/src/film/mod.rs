@@ -13,6 +13,7 @@
 //! filter's reach ([`FilterTable`]), or placed by filter importance
 //! sampling and added to one pixel ([`FilterSampler`], pbrt-v4).
 
+pub mod alpha;
 pub mod aov;
 pub mod band;
 pub mod denoise;

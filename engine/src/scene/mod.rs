@@ -595,6 +595,8 @@ struct FilmParams {
     exr: crate::film::encoding::ExrSamples,
     #[serde(default = "default_jpeg_quality")]
     jpeg_quality: u8,
+    #[serde(default)]
+    alpha: bool,
     /// The keys above as the encoder takes them (checked after parsing).
     #[serde(skip)]
     encoding: crate::film::encoding::Encoding,
@@ -645,6 +647,7 @@ fn film_encoding(
         bit_depth: p.bit_depth,
         exr: p.exr,
         jpeg_quality: p.jpeg_quality,
+        alpha: p.alpha,
     })
 }
 
@@ -681,6 +684,7 @@ fn parse_film(
                 bit_depth: Default::default(),
                 exr: Default::default(),
                 jpeg_quality: default_jpeg_quality(),
+                alpha: false,
                 encoding: Default::default(),
             },
             default_module("gaussian"),
@@ -695,7 +699,7 @@ fn parse_film(
     let height = map.get("height");
     // Parsed with the other plain keys below.
     map.get("filter_sampling");
-    for key in ["tonemap", "bit_depth", "exr", "jpeg_quality"] {
+    for key in ["tonemap", "bit_depth", "exr", "jpeg_quality", "alpha"] {
         map.get(key);
     }
     map.finish(&[
@@ -707,6 +711,7 @@ fn parse_film(
         "bit_depth",
         "exr",
         "jpeg_quality",
+        "alpha",
     ])?;
     let mut rest = marked_yaml::types::MarkedMappingNode::new_empty(*node.span());
     for (key, value) in node.as_mapping().into_iter().flat_map(|m| m.iter()) {

@@ -143,7 +143,9 @@ pub(super) fn write(
         }
         None => rendered.image,
     };
-    if aovs.is_empty() {
+    if aovs.is_empty() && scene.settings.output.alpha {
+        radiant::film::alpha::write(path, &image, &planes.alpha, &scene.settings.output)
+    } else if aovs.is_empty() {
         output::write_encoded(path, &image, &scene.settings.output)
     } else {
         layers::write(path, &image, &planes, aovs)
