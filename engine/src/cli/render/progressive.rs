@@ -240,11 +240,6 @@ pub(super) fn start(args: &RenderArgs) -> miette::Result<Option<Session>> {
             args.frames.map_or(0, |f| f.1)
         );
     }
-    if args.passes.wanted() {
-        miette::bail!(
-            "--time, --checkpoint and --resume render the image alone: leave out the output variables (--aov), or render them without these"
-        );
-    }
     let scene_bytes = std::fs::read(&args.scene)
         .map_err(|e| miette::miette!("cannot read the scene `{}`: {e}", args.scene.display()))?;
     Ok(Some(Session {
