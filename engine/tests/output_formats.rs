@@ -343,6 +343,14 @@ fn alpha_is_the_coverage_in_png_and_exr() {
     let pixels = &exr.layer_data.channel_data.pixels;
     assert_eq!(pixels[12 * 24 + 12][3], 1.0);
     assert_eq!(pixels[0][3], 0.0);
+    // A progressive render keeps no coverage: refused before rendering.
+    let o = radiant_in(
+        dir.path(),
+        &["render", scene, "-o", "t.png", "--time", "5s"],
+    );
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("needs a whole render"));
+    assert!(!dir.path().join("t.png").exists());
     // JPEG has no alpha channel: refused.
     let o = radiant_in(dir.path(), &["render", scene, "-o", "ball.jpg"]);
     assert!(!o.status.success());

@@ -299,6 +299,13 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         let base = totals.frames * per_frame;
         let progress = |done: u64, _total: u64| bar.set_position(base + done);
         let path = frame_path(&args.output, frame);
+        if progressive.is_some() && settings.output.alpha {
+            miette::bail!(
+                "alpha (film: {{alpha: true}} or --alpha) needs a whole render: --time, \
+                 --checkpoint and --resume write the image alone; leave alpha out or render a \
+                 fixed --spp"
+            );
+        }
         let rendered = pool.install(|| {
             let progress = Progress::new(&progress);
             if let Some(session) = &progressive {
