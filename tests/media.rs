@@ -545,3 +545,30 @@ fn an_emitting_absorber_glows_as_the_closed_form() {
         );
     }
 }
+
+#[test]
+fn juice_in_a_glass_is_tinted_by_its_absorption() {
+    // An absorbing chromatic liquid (σa = 0.05, 0.6, 2 per unit length)
+    // inside a dielectric sphere (η = 1.33) under a uniform environment:
+    // rays refract in, are absorbed along their way through the liquid and
+    // refract out. Finite, darker than the environment, and the centre is
+    // tinted in the order of the absorption: nearly the environment in
+    // red (e^(−0.1) ≈ 0.9 before Fresnel), e^(−4) ≈ 0.02 in blue.
+    let text = furnace("{type: homogeneous, sigma_a: [0.05, 0.6, 2], sigma_s: 0}").replace(
+        "material: {type: null}",
+        "material: {type: dielectric, int_ior: 1.33}",
+    );
+    assert!(text.contains("dielectric"));
+    let r = render_text(&text, Overrides::default());
+    assert_eq!(r.invalid_samples, 0);
+    // Roulette inside the glass divides survivors by their survival
+    // probability, so a pixel may exceed 1 by noise; the image as a whole
+    // may not.
+    let (mean, max) = mean_and_max(&r.image);
+    assert!(mean < 1.0 && max < 1.5, "mean {mean}, a pixel at {max}");
+    let c = r.image.pixels[8 * 16 + 8];
+    assert!(
+        c.x > 0.75 && c.x < 1.0 && c.y < c.x && c.z < c.y && c.z < 0.1,
+        "centre {c}"
+    );
+}
