@@ -124,6 +124,12 @@ pub const SCENE_KEYS: &[KeyDocs] = &[
             key("bit_depth", "8 | 16", "8", "PNG bits per channel."),
             key("exr", "float | half", "float", "EXR sample type."),
             key("jpeg_quality", "1–100", "90", "JPEG quality."),
+            key(
+                "alpha",
+                "bool",
+                "false",
+                "Coverage as an alpha channel (RGBA PNG, straight; EXR, premultiplied).",
+            ),
         ],
     },
     KeyDocs {
