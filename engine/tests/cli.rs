@@ -401,6 +401,10 @@ fn out_of_range_arguments_are_refused_with_the_allowed_range() {
         ("--height", "40000", "1..=32768"),
         ("--threads", "10000", "1..=1024"),
         ("--spp", "0", "1.."),
+        ("--spp", "-4", "1.."),
+        ("--spp", "2.5", "whole number"),
+        ("--width", "-3", "1..=32768"),
+        ("--threads", "-1", "1..=1024"),
         ("--max-depth", "-2", "-1.."),
     ] {
         let o = radiant(&["render", "scenes/cornell-box.yaml", "-o", out, flag, value]);

@@ -81,6 +81,21 @@ fn partitions_merge_into_the_single_machine_image() {
         assert!(merge(&whole, &alone).status.success());
         assert_eq!(read(&alone), read(&single), "{sampler}");
     }
+    // A merged PNG is encoded as merge's options say, byte for byte as the
+    // single render writes it with the same options.
+    let encoded = ["--tonemap", "aces", "--bit-depth", "16"];
+    let scene = dir.path().join("independent.yaml");
+    let single = dir.path().join("single.png");
+    render(&scene, "5", &single, &encoded);
+    let parts = partitions(&scene, dir.path(), 3, &[1, 2, 3], &[]);
+    let merged = dir.path().join("merged.png");
+    let mut args = vec!["merge"];
+    args.extend(parts.iter().map(|f| arg(f)));
+    args.extend(["-o", arg(&merged)]);
+    args.extend(encoded);
+    let o = radiant(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(std::fs::read(&merged).unwrap() == std::fs::read(&single).unwrap());
     // The tolerance has power: the same frame with another seed is far off.
     let scene = shot(dir.path(), "seeded.yaml", "independent");
     let other = dir.path().join("other-seed.exr");

@@ -1,9 +1,10 @@
 //! Progressive renders end to end: `--time` stops within one pass of its
 //! limit, `--checkpoint` files appear while the render runs and are valid,
 //! a render interrupted by SIGINT after its first checkpoint and resumed
-//! gives the uninterrupted render's image bit for bit, a PNG render keeps
-//! its state beside it, and wrong `--resume` inputs are refused naming the
-//! file.
+//! gives the uninterrupted render's image bit for bit (a plain render
+//! too, its samples written when Ctrl-C stops it), a PNG render keeps
+//! its state beside it (and is encoded as a plain render encodes it), and
+//! wrong `--resume` inputs are refused naming the file.
 
 // `unwrap`/`expect` in this test code is the assertion: the inputs are the
 // test's own, so a failure is a bug, and the panic reports it.
@@ -14,7 +15,7 @@ mod common;
 use common::{arg, radiant, read, shot, stderr};
 use radiant::farm::partial;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 /// The arguments of `radiant render SCENE -o OUT` on the CPU with two
@@ -97,12 +98,7 @@ fn time_limited_renders_stop_within_a_pass_of_the_limit() {
 /// it SIGINT once `out` has appeared (its first checkpoint) and returns its
 /// output.
 fn interrupted(scene: &Path, out: &Path, extra: &[&str]) -> Output {
-    let child = Command::new(env!("CARGO_BIN_EXE_radiant"))
-        .args(render_args(scene, out, extra))
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let child = spawn_render(scene, out, extra);
     let deadline = Instant::now() + Duration::from_secs(120);
     while !out.exists() {
         assert!(Instant::now() < deadline, "no checkpoint in 120 s");
@@ -112,6 +108,22 @@ fn interrupted(scene: &Path, out: &Path, extra: &[&str]) -> Output {
     let first = samples_in(out);
     assert!(first >= 1, "{first}");
     assert!(read(out).mean() > 0.0);
+    interrupt(child)
+}
+
+/// Starts `radiant render SCENE -o OUT` with `extra` options on the CPU,
+/// its stderr piped.
+fn spawn_render(scene: &Path, out: &Path, extra: &[&str]) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_radiant"))
+        .args(render_args(scene, out, extra))
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Sends `child` SIGINT (Ctrl-C) and waits for it.
+fn interrupt(child: Child) -> Output {
     let kill = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()
@@ -120,14 +132,19 @@ fn interrupted(scene: &Path, out: &Path, extra: &[&str]) -> Output {
     child.wait_with_output().unwrap()
 }
 
+/// Enough samples per pixel for several seconds of `scene`: what one
+/// second renders (a `--time` render into `dir`), times 8.
+fn seconds_of_samples(scene: &Path, dir: &Path) -> String {
+    let probe = dir.join("probe.exr");
+    rendered(scene, &probe, &["--time", "1s", "--spp", "1000000"]);
+    (samples_in(&probe) * 8).max(64).to_string()
+}
+
 #[test]
 fn an_interrupted_render_resumes_into_the_uninterrupted_image() {
     let dir = tempfile::tempdir().unwrap();
     let scene = shot(dir.path(), "shot.yaml", "independent");
-    // Enough samples for several seconds: what one second renders, times 8.
-    let probe = dir.path().join("probe.exr");
-    rendered(&scene, &probe, &["--time", "1s", "--spp", "1000000"]);
-    let spp = (samples_in(&probe) * 8).max(64).to_string();
+    let spp = seconds_of_samples(&scene, dir.path());
 
     let out = dir.path().join("frame.exr");
     let o = interrupted(&scene, &out, &["--spp", &spp, "--checkpoint", "0.2s"]);
@@ -159,6 +176,58 @@ fn an_interrupted_render_resumes_into_the_uninterrupted_image() {
     assert!(single.mean() > 0.0);
 }
 
+/// Waits until process `pid` handles SIGINT (bit 1 of the `SigCgt` mask
+/// in its /proc status), for at most 120 s.
+fn wait_for_sigint_handler(pid: u32) {
+    let deadline = Instant::now() + Duration::from_secs(120);
+    loop {
+        let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
+        let caught = status
+            .lines()
+            .find_map(|l| l.strip_prefix("SigCgt:"))
+            .map(|mask| u64::from_str_radix(mask.trim(), 16).unwrap())
+            .unwrap();
+        if caught & 2 != 0 {
+            return;
+        }
+        assert!(Instant::now() < deadline, "SIGINT not handled in 120 s");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+#[test]
+fn a_plain_render_interrupted_keeps_its_samples_and_resumes() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = shot(dir.path(), "shot.yaml", "independent");
+    let spp = seconds_of_samples(&scene, dir.path());
+
+    // No --time, --checkpoint or --resume: a plain render, stopped by
+    // Ctrl-C a second after it starts handling it.
+    let out = dir.path().join("frame.png");
+    let child = spawn_render(&scene, &out, &["--spp", &spp]);
+    wait_for_sigint_handler(child.id());
+    std::thread::sleep(Duration::from_secs(1));
+    let o = interrupt(child);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(130), "{e}");
+    let state = dir.path().join("frame.png.resume.exr");
+    let held = samples_in(&state);
+    assert!(held >= 1 && held < spp.parse().unwrap(), "{held}: {e}");
+    assert!(
+        e.contains(&format!("interrupted: {held} of {spp} spp")),
+        "{e}"
+    );
+    assert!(out.exists());
+
+    // Resumed, it is the uninterrupted render, byte for byte; a plain
+    // render that ends leaves no state beside its image.
+    rendered(&scene, &out, &["--spp", &spp, "--resume", arg(&state)]);
+    let single = dir.path().join("single.png");
+    rendered(&scene, &single, &["--spp", &spp]);
+    assert!(!dir.path().join("single.png.resume.exr").exists());
+    assert!(std::fs::read(&out).unwrap() == std::fs::read(&single).unwrap());
+}
+
 #[test]
 fn a_png_render_keeps_its_state_beside_it() {
     let dir = tempfile::tempdir().unwrap();
@@ -187,6 +256,17 @@ fn a_png_render_keeps_its_state_beside_it() {
     rendered(&scene, &exr, &["--spp", "32"]);
     assert_eq!(samples_in(&state), 32);
     assert!(read(&state) == read(&exr));
+    // The PNG is encoded as the options say (16-bit, Reinhard), byte for
+    // byte as a plain render of the same samples writes it.
+    let encoded = ["--spp", "8", "--tonemap", "reinhard", "--bit-depth", "16"];
+    let (checkpointed, plain) = (dir.path().join("kept.png"), dir.path().join("plain.png"));
+    rendered(
+        &scene,
+        &checkpointed,
+        &[&encoded[..], &["--checkpoint", "10s"]].concat(),
+    );
+    rendered(&scene, &plain, &encoded);
+    assert!(std::fs::read(&checkpointed).unwrap() == std::fs::read(&plain).unwrap());
 }
 
 /// Runs a render resuming from `from` with `extra` options, expects it to

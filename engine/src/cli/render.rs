@@ -205,10 +205,10 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
     if let Some(p) = args.partition {
         return partition::run(registry, args, p);
     }
-    let progressive = progressive::start(args)?;
     let pattern = args.output.to_string_lossy().contains('#');
     check_output(&frame_path(&args.output, 0))?;
     let mut scene = radiant::scene::load(&args.scene).map_err(report)?;
+    let progressive = progressive::start(args)?;
     let timeline = scene.timeline;
     let (first, last) = args.frames.unwrap_or((timeline.start, timeline.start));
     check_frames(&args.scene, &timeline, (first, last))?;
@@ -299,20 +299,22 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         let base = totals.frames * per_frame;
         let progress = |done: u64, _total: u64| bar.set_position(base + done);
         let path = frame_path(&args.output, frame);
-        if progressive.is_some() && settings.output.alpha {
+        if progressive.as_ref().is_some_and(|p| p.asked()) && settings.output.alpha {
             miette::bail!(
                 "alpha (film: {{alpha: true}} or --alpha) needs a whole render: --time, \
                  --checkpoint and --resume write the image alone; leave alpha out or render a \
                  fixed --spp"
             );
         }
+        // Alpha is the coverage plane, which the passes record.
+        let planes = args.passes.wanted() || settings.output.alpha;
+        let session = progressive.as_ref().filter(|p| p.takes(s, planes));
         let rendered = pool.install(|| {
             let progress = Progress::new(&progress);
-            if let Some(session) = &progressive {
+            if let Some(session) = session {
                 let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
                 session.render(args, backend.as_mut(), (s, frame), &path, &progress, &note)
-            } else if args.passes.wanted() || settings.output.alpha {
-                // Alpha is the coverage plane, which the passes record.
+            } else if planes {
                 let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
                 passes::write(&args.passes, s, &path, &progress, &note)
             } else {

@@ -10,7 +10,7 @@ use radiant::extract::Overrides;
 #[derive(Args)]
 pub struct SamplingArgs {
     /// Samples per pixel, at least 1 (overrides the scene's sampler).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, allow_negative_numbers = true, value_parser = samples_per_pixel)]
     pub spp: Option<u32>,
     /// Longest path in segments; -1 for unlimited (overrides the scene).
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(i32).range(-1..))]
@@ -18,6 +18,22 @@ pub struct SamplingArgs {
     /// Sampler seed (of the scene's first frame; the others derive theirs).
     #[arg(long)]
     pub seed: Option<u64>,
+}
+
+/// Parses `--spp`: a whole number in 1..=2³²−1. Negative numbers reach
+/// it (`allow_negative_numbers`), so `--spp -4` is called out of range
+/// rather than an unexpected argument.
+fn samples_per_pixel(text: &str) -> Result<u32, String> {
+    let max = u32::MAX;
+    match text.trim().parse::<i64>() {
+        Ok(n) => u32::try_from(n)
+            .ok()
+            .filter(|&n| n >= 1)
+            .ok_or_else(|| format!("{n} is not in 1..={max}: samples per pixel are 1 or more")),
+        Err(_) => Err(format!(
+            "`{text}` is not a whole number of samples per pixel (1..={max})"
+        )),
+    }
 }
 
 impl SamplingArgs {

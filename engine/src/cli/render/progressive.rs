@@ -5,6 +5,12 @@
 //! `NAME.png.resume.exr` beside it), Ctrl-C stopping it after the pass in
 //! progress with the image so far written (exit status 130; a second
 //! Ctrl-C quits at once, writing nothing more).
+//!
+//! A plain render of one frame goes through the same passes where its
+//! whole film fits in [`PLAIN_FILM_BYTES`], so that Ctrl-C keeps its
+//! samples too; it writes only the image when it ends, and the state only
+//! when it is interrupted. The film's sums are exact, so its image is the
+//! one the banded render (which larger frames keep) makes, bit for bit.
 
 use super::RenderArgs;
 use clap::Args;
@@ -18,6 +24,11 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
+
+/// The largest film (its exact sums) a plain render keeps whole so that
+/// Ctrl-C can write its samples so far: 16 Mpixels; larger frames render
+/// in bands ([`radiant::backend::cpu::write`]), holding little memory.
+const PLAIN_FILM_BYTES: u64 = 1 << 30;
 
 /// Exit status of a render stopped by Ctrl-C (128 + SIGINT, as shells
 /// report it), after the image so far is written.
@@ -76,22 +87,20 @@ pub fn parse_duration(text: &str) -> Result<Duration, String> {
         .ok_or_else(|| format!("`{text}` is not a positive time"))
 }
 
-/// The interrupt flag, raised by the first Ctrl-C; a second one exits at
-/// once with [`INTERRUPTED`].
-pub(super) fn interrupt_flag() -> miette::Result<Arc<AtomicBool>> {
+/// Has the first Ctrl-C raise `flag`, and a second one exit at once with
+/// [`INTERRUPTED`].
+fn handle_interrupts(flag: &Arc<AtomicBool>) -> miette::Result<()> {
     use signal_hook::consts::SIGINT;
-    let flag = Arc::new(AtomicBool::new(false));
     let install = || -> std::io::Result<()> {
         signal_hook::flag::register_conditional_shutdown(
             SIGINT,
             i32::from(INTERRUPTED),
-            Arc::clone(&flag),
+            Arc::clone(flag),
         )?;
-        signal_hook::flag::register(SIGINT, Arc::clone(&flag))?;
+        signal_hook::flag::register(SIGINT, Arc::clone(flag))?;
         Ok(())
     };
-    install().map_err(|e| miette::miette!("cannot handle Ctrl-C: {e}"))?;
-    Ok(flag)
+    install().map_err(|e| miette::miette!("cannot handle Ctrl-C: {e}"))
 }
 
 /// Why a progressive frame failed.
@@ -131,6 +140,8 @@ pub(super) fn render(
     args: &ProgressiveArgs,
     progress: &Progress<'_>,
 ) -> Result<(Written, Outcome), FrameError> {
+    // A plain render that ends keeps no state: its output is the image alone.
+    let plain = !args.is_set();
     let s = &frame.scene.settings;
     let (mut film, done) = match &args.resume {
         Some(from) => {
@@ -161,7 +172,9 @@ pub(super) fn render(
         &controls,
         &mut checkpoint,
     )?;
-    if outcome.samples > 0 {
+    if plain && outcome.stop == Stop::Done {
+        write_image(frame, &film)?;
+    } else if outcome.samples > 0 {
         write(frame, &film, outcome.samples)?;
     }
     let pixels = u64::from(s.width) * u64::from(s.height);
@@ -186,9 +199,16 @@ fn write(frame: &Frame<'_>, film: &Film, samples: u32) -> Result<(), FrameError>
     let state = state_path(frame.path);
     partial::write(&state, &header, film)?;
     if state != frame.path {
-        let image = film.try_develop().map_err(RenderError::from)?;
-        radiant::film::output::write(frame.path, &image)?;
+        write_image(frame, film)?;
     }
+    Ok(())
+}
+
+/// Writes the image of `film`, encoded as the frame's settings say,
+/// atomically.
+fn write_image(frame: &Frame<'_>, film: &Film) -> Result<(), FrameError> {
+    let image = film.try_develop().map_err(RenderError::from)?;
+    radiant::film::output::write_encoded(frame.path, &image, &frame.scene.settings.output)?;
     Ok(())
 }
 
@@ -224,13 +244,22 @@ pub(super) fn describe(outcome: &Outcome, path: &Path, spp: u32) -> String {
 pub(super) struct Session {
     scene_bytes: Vec<u8>,
     interrupt: Arc<AtomicBool>,
+    /// Whether `--time`, `--checkpoint` or `--resume` asked for it (else
+    /// it is a plain render's, kept for Ctrl-C).
+    asked: bool,
+    /// Whether Ctrl-C is handled yet: from the start where passes were
+    /// asked for; in a plain render from its first frame in passes (until
+    /// then Ctrl-C quits at once, as it does in a banded render).
+    handling: AtomicBool,
 }
 
 /// The session of a progressive render where `args` ask for one (and
-/// nothing it cannot do with), handling Ctrl-C from now on.
+/// nothing it cannot do with) or render one frame plainly, handling
+/// Ctrl-C from now on.
 pub(super) fn start(args: &RenderArgs) -> miette::Result<Option<Session>> {
     let p = &args.progressive;
-    if !p.is_set() {
+    let one_frame = args.frames.is_none_or(|(a, b)| a == b);
+    if !p.is_set() && !one_frame {
         return Ok(None);
     }
     if p.resume.is_some() && args.frames.is_some_and(|(a, b)| b > a) {
@@ -242,13 +271,46 @@ pub(super) fn start(args: &RenderArgs) -> miette::Result<Option<Session>> {
     }
     let scene_bytes = std::fs::read(&args.scene)
         .map_err(|e| miette::miette!("cannot read the scene `{}`: {e}", args.scene.display()))?;
-    Ok(Some(Session {
+    let session = Session {
         scene_bytes,
-        interrupt: interrupt_flag()?,
-    }))
+        interrupt: Arc::new(AtomicBool::new(false)),
+        asked: p.is_set(),
+        handling: AtomicBool::new(false),
+    };
+    if session.asked {
+        session.handle_interrupts()?;
+    }
+    Ok(Some(session))
 }
 
 impl Session {
+    /// Whether `--time`, `--checkpoint` or `--resume` asked for passes.
+    pub(super) fn asked(&self) -> bool {
+        self.asked
+    }
+
+    /// Handles Ctrl-C from now on (once).
+    fn handle_interrupts(&self) -> miette::Result<()> {
+        if !self.handling.swap(true, Ordering::Relaxed) {
+            handle_interrupts(&self.interrupt)?;
+        }
+        Ok(())
+    }
+
+    /// Whether this session renders `scene`'s frame: always where passes
+    /// were asked for; for a plain render, where it needs no first-hit
+    /// planes (`passes`: AOVs, denoising, alpha keep their own path) and its
+    /// whole film fits in memory and in [`PLAIN_FILM_BYTES`].
+    pub(super) fn takes(&self, scene: &RenderScene, passes: bool) -> bool {
+        use radiant::film::memory::{FrameTooLarge, SUM_BYTES};
+        let s = &scene.settings;
+        let bytes = u64::from(s.width) * u64::from(s.height) * SUM_BYTES;
+        self.asked
+            || (!passes
+                && bytes <= PLAIN_FILM_BYTES
+                && FrameTooLarge::new(s.width, s.height).check().is_ok())
+    }
+
     /// Renders `frame` of `args.scene` (its scene `scene`) to `path` on
     /// `backend`, saying how it went through `note`.
     pub(super) fn render(
@@ -260,6 +322,7 @@ impl Session {
         progress: &Progress<'_>,
         note: &dyn Fn(&str),
     ) -> miette::Result<Written> {
+        self.handle_interrupts()?;
         let frame_state = Frame {
             scene,
             header: Header::new(
@@ -275,7 +338,9 @@ impl Session {
         };
         let (written, outcome) = render(backend, &frame_state, &args.progressive, progress)
             .map_err(|e| miette::miette!("{e}"))?;
-        note(&describe(&outcome, path, scene.settings.spp));
+        if self.asked || outcome.stop != Stop::Done {
+            note(&describe(&outcome, path, scene.settings.spp));
+        }
         Ok(written)
     }
 
