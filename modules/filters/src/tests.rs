@@ -205,7 +205,7 @@ fn bad_parameters_are_rejected_at_their_key() {
         ("mitchell", "radius: 1e39", 1, "from 0.5 to 32 pixels"),
         ("mitchell", "radius: wide", 1, "number"),
         ("lanczos", "lobes: 0", 1, "1 to 16"),
-        ("lanczos", "lobes: 2.5", 1, "integer"),
+        ("lanczos", "lobes: 2.5", 1, "whole number"),
         ("tent", "width: 2", 1, "width"),
     ] {
         let Err(radiant_core::registry::BuildError::Params(e)) = build(ty, yaml) else {
