@@ -88,9 +88,11 @@ pub fn render_samples_with_aovs(
     samples: Range<u32>,
     progress: &Progress<'_>,
 ) -> Pass {
-    Tiler::new(scene, samples, progress).whole(Tiler::render_aovs, |(tile, aov)| {
-        film.merge(tile);
-        aovs.merge(aov);
+    Tiler::new(scene, samples, progress).whole(Tiler::render_aovs, |tiles| {
+        for (tile, aov) in tiles {
+            film.merge(tile);
+            aovs.merge(aov);
+        }
     })
 }
 
@@ -163,7 +165,7 @@ pub fn render_samples(
     samples: Range<u32>,
     progress: &Progress<'_>,
 ) -> Pass {
-    Tiler::new(scene, samples, progress).whole(Tiler::render, |tile| film.merge(tile))
+    Tiler::new(scene, samples, progress).whole(Tiler::render, |tiles| film.merge_all(tiles))
 }
 
 /// Renders every sample of `scene` in groups of `group` tile rows and
@@ -203,9 +205,7 @@ pub fn render_rows(
         );
         written?;
         finished.clear();
-        for tile in &tiles {
-            film.merge(tile);
-        }
+        film.merge_all(&tiles);
         rays += r;
         film.advance(bands.finished(&group), &mut finished)
             .map_err(|_| too_large())?;
@@ -257,7 +257,7 @@ impl<'a> Tiler<'a> {
     fn whole<T>(
         &self,
         render: impl Fn(&Self, Range<u32>) -> (Vec<T>, u64),
-        mut merge: impl FnMut(&T),
+        mut merge: impl FnMut(&[T]),
     ) -> Pass {
         let start = Instant::now();
         let mut rays = 0;
@@ -266,7 +266,7 @@ impl<'a> Tiler<'a> {
             .groups()
         {
             let (tiles, r) = render(self, group);
-            tiles.iter().for_each(&mut merge);
+            merge(&tiles);
             rays += r;
         }
         Pass {

@@ -215,6 +215,20 @@ impl TileFilm {
         }
     }
 
+    /// Adds row `y` of this tile (its own row index) to `row`, the film's
+    /// row it covers.
+    #[inline]
+    fn add_row(&self, y: usize, row: &mut [Sums]) {
+        let (width, x0) = (self.width as usize, self.x0 as usize);
+        let src = y * width;
+        let sums = &self.sums[src..src + width];
+        let current = &self.current[src..src + width];
+        for ((sum, exact), partial) in row[x0..x0 + width].iter_mut().zip(sums).zip(current) {
+            sum.add(exact);
+            sum.add_f32(*partial);
+        }
+    }
+
     /// Ends a block of sample indices ([`exact::BLOCK`]): the `f32` sums
     /// of its splats are converted into the exact sums. A render splats
     /// the block's sample indices in order, each over all the tile's
@@ -442,16 +456,46 @@ impl Film {
             self.top + self.rows()
         );
         for y in 0..tile.height {
-            let src = (y * tile.width) as usize;
-            let dst =
-                ((tile.y0 as u32 + y as u32 - self.top) * self.width + tile.x0 as u32) as usize;
-            for x in 0..tile.width as usize {
-                let sum = &mut self.sums[dst + x];
-                sum.add(&tile.sums[src + x]);
-                sum.add_f32(tile.current[src + x]);
-            }
+            let dst = ((tile.y0 as u32 + y as u32 - self.top) * self.width) as usize;
+            tile.add_row(y as usize, &mut self.sums[dst..dst + self.width as usize]);
         }
         self.invalid_samples += tile.invalid_samples;
+    }
+
+    /// Adds the sums of `tiles`, as [`Film::merge`] of each would, in
+    /// parallel over the film's rows: each row adds the rows of the tiles
+    /// that reach it. The sums are exact, so the film is the same bit for
+    /// bit whatever order the additions run in; a frame's tiles are many,
+    /// and converting their `f32` block sums is what a serial merge would
+    /// leave the other threads waiting on.
+    ///
+    /// # Panics
+    ///
+    /// If a tile reaches rows the film does not hold.
+    pub fn merge_all(&mut self, tiles: &[TileFilm]) {
+        use rayon::prelude::*;
+        let (top, held) = (self.top as i32, self.rows() as i32);
+        for tile in tiles {
+            assert!(
+                tile.y0 >= top && tile.y0 + tile.height <= top + held,
+                "tile rows {}..{} outside the film's rows {top}..{}",
+                tile.y0,
+                tile.y0 + tile.height,
+                top + held
+            );
+        }
+        self.sums
+            .par_chunks_mut(self.width.max(1) as usize)
+            .enumerate()
+            .for_each(|(r, row)| {
+                let y = top + r as i32;
+                for tile in tiles {
+                    if (tile.y0..tile.y0 + tile.height).contains(&y) {
+                        tile.add_row((y - tile.y0) as usize, row);
+                    }
+                }
+            });
+        self.invalid_samples += tiles.iter().map(|t| t.invalid_samples).sum::<u64>();
     }
 
     /// Develops the rows from the first held up to `until` (exclusive)
@@ -586,6 +630,56 @@ mod tests {
         for p in &image.pixels {
             assert!((*p - Rgb::new(0.25, 0.5, 1.0)).abs().max_element() < 1e-5);
         }
+    }
+
+    #[test]
+    fn merging_all_tiles_at_once_equals_merging_them_one_by_one() {
+        let table = FilterTable::new(&Tent);
+        let (w, h) = (23u32, 19u32);
+        let mut rng = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 40) as f32 / (1u64 << 24) as f32
+        };
+        // Overlapping tiles (the tent reaches 1.5 pixels), some of them
+        // twice, with a block ended half-way so both sums and the f32
+        // block sums are merged.
+        let mut tiles = Vec::new();
+        for (x0, y0) in [
+            (0, 0),
+            (8, 0),
+            (16, 0),
+            (0, 8),
+            (8, 8),
+            (16, 8),
+            (8, 16),
+            (8, 8),
+        ] {
+            let (x1, y1) = ((x0 + 8).min(w), (y0 + 8).min(h));
+            let mut tile = TileFilm::new(x0, y0, x1, y1, (w, h), table.radius());
+            for k in 0..40 {
+                let pos = Vec2::new(
+                    x0 as f32 + next() * (x1 - x0) as f32,
+                    y0 as f32 + next() * (y1 - y0) as f32,
+                );
+                tile.splat(pos, Rgb::new(next(), 10.0 * next(), 1e-3 * next()), &table);
+                if k == 20 {
+                    tile.end_block();
+                }
+            }
+            tiles.push(tile);
+        }
+        let mut one_by_one = Film::new(w, h);
+        for tile in &tiles {
+            one_by_one.merge(tile);
+        }
+        let mut all = Film::new(w, h);
+        all.merge_all(&tiles);
+        assert!(all.sums == one_by_one.sums);
+        assert_eq!(all.develop(), one_by_one.develop());
+        assert!(all.develop().mean() > 0.0);
     }
 
     #[test]
