@@ -28,6 +28,12 @@ const TILE: u32 = 16;
 const BATCH_PATHS: u32 = 1024;
 /// Tiles each thread renders per group, at least (see [`group_tile_rows`]).
 const GROUP_TILES_PER_THREAD: usize = 16;
+/// Groups of a whole-film pass are this many times larger: a pass may hold
+/// a few samples of each tile, and every group ends in a wait for its last
+/// tile, so small groups would wait more often than a banded render's do
+/// (its groups hold all samples), while the tile films of a larger group
+/// (about 32 KB a tile) are still few megabytes.
+const WHOLE_GROUP_FACTOR: u32 = 8;
 
 /// Renders `scene` on all threads of the current rayon pool.
 ///
@@ -261,10 +267,8 @@ impl<'a> Tiler<'a> {
     ) -> Pass {
         let start = Instant::now();
         let mut rays = 0;
-        for group in self
-            .bands(group_tile_rows(self.scene.settings.width))
-            .groups()
-        {
+        let group = group_tile_rows(self.scene.settings.width) * WHOLE_GROUP_FACTOR;
+        for group in self.bands(group).groups() {
             let (tiles, r) = render(self, group);
             merge(&tiles);
             rays += r;

@@ -636,12 +636,11 @@ mod tests {
     fn merging_all_tiles_at_once_equals_merging_them_one_by_one() {
         let table = FilterTable::new(&Tent);
         let (w, h) = (23u32, 19u32);
-        let mut rng = 0x2545_f491_4f6c_dd1du64;
+        // Fractions of a multiplicative hash of a counter: scattered enough.
+        let mut i = 0u32;
         let mut next = move || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 40) as f32 / (1u64 << 24) as f32
+            i += 1;
+            (i.wrapping_mul(0x9e37_79b9) >> 8) as f32 / (1u32 << 24) as f32
         };
         // Overlapping tiles (the tent reaches 1.5 pixels), some of them
         // twice, with a block ended half-way so both sums and the f32
