@@ -367,6 +367,8 @@ impl AovImage {
 
 #[cfg(test)]
 mod tests {
+    // `unwrap` in this test code is the assertion: the film sizes are the test's own, so a failure is a bug,
+    // and the panic reports it.
     use super::*;
     use crate::settings::FilterSampling;
     use radiant_filters::{TentFilter, TentKernel};

@@ -191,6 +191,8 @@ fn agx(x: Rgb) -> Rgb {
 
 #[cfg(test)]
 mod tests {
+    // `unwrap` in this test code is the assertion: the curves and exposures are the test's own, so a failure is a bug,
+    // and the panic reports it.
     use super::*;
     use crate::film::output::srgb_encode;
 

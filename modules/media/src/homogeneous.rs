@@ -162,6 +162,8 @@ pub(crate) fn register(registry: &mut Registry) {
 
 #[cfg(test)]
 mod tests {
+    // `unwrap` in this test code is the assertion: the parameters are the test's own, so a failure is a bug,
+    // and the panic reports it.
     use super::*;
     use radiant_core::params::check_param_docs;
 
