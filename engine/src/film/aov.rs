@@ -28,6 +28,7 @@
 //! it next to the developed image.
 
 use super::memory::{FrameTooLarge, try_filled};
+use super::tile::TileBounds;
 use super::{FilterTable, Reconstruction};
 use glam::{Vec2, Vec3};
 use radiant_core::Rgb;
@@ -180,12 +181,7 @@ fn add(sum: &mut [f32; CHANNELS], v: &[f32; CHANNELS]) {
 /// filter (the counterpart of [`super::TileFilm`]).
 #[derive(Debug, Clone)]
 pub struct AovTile {
-    x0: i32,
-    y0: i32,
-    width: i32,
-    height: i32,
-    image_width: i32,
-    image_height: i32,
+    bounds: TileBounds,
     sums: Vec<[f32; CHANNELS]>,
     spp: Vec<u32>,
 }
@@ -194,29 +190,12 @@ impl AovTile {
     /// A tile for the pixels [x0, x1) × [y0, y1) of a `size` image, grown
     /// by the filter's reach and clipped to the image.
     pub fn new(x0: u32, y0: u32, x1: u32, y1: u32, size: (u32, u32), reach: f32) -> Self {
-        let border = reach.ceil() as i32;
-        let (w, h) = (size.0 as i32, size.1 as i32);
-        let bx0 = (x0 as i32 - border).max(0);
-        let by0 = (y0 as i32 - border).max(0);
-        let bx1 = (x1 as i32 + border).min(w);
-        let by1 = (y1 as i32 + border).min(h);
-        let len = ((bx1 - bx0) * (by1 - by0)) as usize;
+        let bounds = TileBounds::new(x0, y0, x1, y1, size, reach);
         Self {
-            x0: bx0,
-            y0: by0,
-            width: bx1 - bx0,
-            height: by1 - by0,
-            image_width: w,
-            image_height: h,
-            sums: vec![[0.0; CHANNELS]; len],
-            spp: vec![0; len],
+            bounds,
+            sums: vec![[0.0; CHANNELS]; bounds.len()],
+            spp: vec![0; bounds.len()],
         }
-    }
-
-    /// The index of pixel (`x`, `y`) of the image in the tile.
-    #[inline]
-    fn index(&self, x: i32, y: i32) -> usize {
-        ((y - self.y0) * self.width + x - self.x0) as usize
     }
 
     /// Adds the samples `hits` of the pixels `pixels` (indices into the
@@ -231,10 +210,10 @@ impl AovTile {
         weights: &[f32],
         hits: &[FirstHit],
     ) {
-        let width = self.image_width as u32;
+        let width = self.bounds.image_width as u32;
         for (k, pixel) in pixels.enumerate() {
             let (x, y) = ((pixel % width) as i32, (pixel / width) as i32);
-            let i = self.index(x, y);
+            let i = self.bounds.index(x, y);
             self.spp[i] += 1;
             let hit = &hits[k];
             if !hit.is_finite() {
@@ -250,17 +229,13 @@ impl AovTile {
     /// Adds `hit`, sampled at raster position `pos`, to every pixel within
     /// the filter's radius.
     fn splat(&mut self, pos: Vec2, hit: &FirstHit, table: &FilterTable) {
-        let r = table.radius();
-        let px0 = ((pos.x - 0.5 - r).ceil() as i32).max(0);
-        let px1 = ((pos.x - 0.5 + r).floor() as i32).min(self.image_width - 1);
-        let py0 = ((pos.y - 0.5 - r).ceil() as i32).max(0);
-        let py1 = ((pos.y - 0.5 + r).floor() as i32).min(self.image_height - 1);
+        let (px0, px1, py0, py1) = self.bounds.footprint(pos, table.radius());
         for y in py0..=py1 {
             let dy = y as f32 + 0.5 - pos.y;
             for x in px0..=px1 {
                 let w = table.weight(x as f32 + 0.5 - pos.x, dy);
                 if w != 0.0 {
-                    let i = self.index(x, y);
+                    let i = self.bounds.index(x, y);
                     add(&mut self.sums[i], &hit.weighted(w));
                 }
             }
@@ -293,10 +268,11 @@ impl AovFilm {
 
     /// Adds a tile's sums.
     pub fn merge(&mut self, tile: &AovTile) {
-        for y in 0..tile.height {
-            let src = (y * tile.width) as usize;
-            let dst = ((tile.y0 + y) as u32 * self.width + tile.x0 as u32) as usize;
-            for x in 0..tile.width as usize {
+        let b = &tile.bounds;
+        for y in 0..b.height {
+            let src = (y * b.width) as usize;
+            let dst = ((b.y0 + y) as u32 * self.width + b.x0 as u32) as usize;
+            for x in 0..b.width as usize {
                 add(&mut self.sums[dst + x], &tile.sums[src + x]);
                 self.spp[dst + x] += tile.spp[src + x];
             }

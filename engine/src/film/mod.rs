@@ -25,12 +25,14 @@ pub mod memory;
 pub mod output;
 pub mod rgbe;
 pub mod sheet;
+mod tile;
 pub mod tonemap;
 
 use crate::settings::FilterSampling;
 use exact::Sums;
 use glam::{Vec2, Vec4};
 use radiant_core::{Filter, FilterSampler, Rgb};
+use tile::TileBounds;
 
 /// Entries per axis of the tabulated filter quadrant.
 const TABLE_RES: usize = 64;
@@ -177,12 +179,7 @@ impl Reconstruction {
 /// the filter.
 #[derive(Debug, Clone)]
 pub struct TileFilm {
-    x0: i32,
-    y0: i32,
-    width: i32,
-    height: i32,
-    image_width: i32,
-    image_height: i32,
+    bounds: TileBounds,
     /// (Σ w·r, Σ w·g, Σ w·b, Σ w) per pixel of the splats since the last
     /// [`TileFilm::end_block`], in `f32`.
     current: Vec<Vec4>,
@@ -196,21 +193,11 @@ impl TileFilm {
     /// A tile for the pixels [x0, x1) × [y0, y1) of a `size` image, grown by
     /// the filter radius and clipped to the image.
     pub fn new(x0: u32, y0: u32, x1: u32, y1: u32, size: (u32, u32), radius: f32) -> Self {
-        let border = radius.ceil() as i32;
-        let (w, h) = (size.0 as i32, size.1 as i32);
-        let bx0 = (x0 as i32 - border).max(0);
-        let by0 = (y0 as i32 - border).max(0);
-        let bx1 = (x1 as i32 + border).min(w);
-        let by1 = (y1 as i32 + border).min(h);
+        let bounds = TileBounds::new(x0, y0, x1, y1, size, radius);
         Self {
-            x0: bx0,
-            y0: by0,
-            width: bx1 - bx0,
-            height: by1 - by0,
-            image_width: w,
-            image_height: h,
-            current: vec![Vec4::ZERO; ((bx1 - bx0) * (by1 - by0)) as usize],
-            sums: vec![Sums::ZERO; ((bx1 - bx0) * (by1 - by0)) as usize],
+            bounds,
+            current: vec![Vec4::ZERO; bounds.len()],
+            sums: vec![Sums::ZERO; bounds.len()],
             invalid_samples: 0,
         }
     }
@@ -219,7 +206,7 @@ impl TileFilm {
     /// row it covers.
     #[inline]
     fn add_row(&self, y: usize, row: &mut [Sums]) {
-        let (width, x0) = (self.width as usize, self.x0 as usize);
+        let (width, x0) = (self.bounds.width as usize, self.bounds.x0 as usize);
         let src = y * width;
         let sums = &self.sums[src..src + width];
         let current = &self.current[src..src + width];
@@ -248,11 +235,7 @@ impl TileFilm {
     #[inline]
     pub fn splat(&mut self, pos: Vec2, value: Rgb, table: &FilterTable) {
         let value = self.checked(value);
-        let r = table.radius;
-        let px0 = ceil_i32(pos.x - 0.5 - r).max(0);
-        let px1 = floor_i32(pos.x - 0.5 + r).min(self.image_width - 1);
-        let py0 = ceil_i32(pos.y - 0.5 - r).max(0);
-        let py1 = floor_i32(pos.y - 0.5 + r).min(self.image_height - 1);
+        let (px0, px1, py0, py1) = self.bounds.footprint(pos, table.radius);
         let v = value.extend(1.0);
         let taps = (px1 - px0 + 1).max(0) as usize;
         if let (Some(g), true) = (&table.separable, taps <= MAX_TAPS) {
@@ -261,7 +244,7 @@ impl TileFilm {
             for (x, w) in (px0..).zip(&mut wx[..taps]) {
                 *w = table.factor(g, x as f32 + 0.5 - pos.x);
             }
-            let mut start = ((py0 - self.y0) * self.width + px0 - self.x0) as usize;
+            let mut start = self.bounds.index(px0, py0);
             for y in py0..=py1 {
                 let vy = v * table.factor(g, y as f32 + 0.5 - pos.y);
                 for (sum, &w) in self.current[start..start + taps]
@@ -270,17 +253,18 @@ impl TileFilm {
                 {
                     *sum += vy * w;
                 }
-                start += self.width as usize;
+                start += self.bounds.width as usize;
             }
             return;
         }
+        let b = self.bounds;
         for y in py0..=py1 {
             let dy = y as f32 + 0.5 - pos.y;
-            let row = &mut self.current[((y - self.y0) * self.width) as usize..];
+            let row = &mut self.current[b.index(b.x0, y)..];
             for x in px0..=px1 {
                 let w = table.weight(x as f32 + 0.5 - pos.x, dy);
                 if w != 0.0 {
-                    row[(x - self.x0) as usize] += v * w;
+                    row[(x - b.x0) as usize] += v * w;
                 }
             }
         }
@@ -303,7 +287,7 @@ impl TileFilm {
     #[inline]
     pub fn add(&mut self, x: u32, y: u32, value: Rgb, weight: f32) {
         let value = self.checked(value);
-        let i = ((y as i32 - self.y0) * self.width + x as i32 - self.x0) as usize;
+        let i = self.bounds.index(x as i32, y as i32);
         self.current[i] += (value * weight).extend(weight);
     }
 }
@@ -448,15 +432,16 @@ impl Film {
     /// If the tile reaches rows the film does not hold.
     pub fn merge(&mut self, tile: &TileFilm) {
         assert!(
-            tile.y0 as u32 >= self.top && (tile.y0 + tile.height) as u32 <= self.top + self.rows(),
+            tile.bounds.y0 as u32 >= self.top
+                && (tile.bounds.y0 + tile.bounds.height) as u32 <= self.top + self.rows(),
             "tile rows {}..{} outside the film's rows {}..{}",
-            tile.y0,
-            tile.y0 + tile.height,
+            tile.bounds.y0,
+            tile.bounds.y0 + tile.bounds.height,
             self.top,
             self.top + self.rows()
         );
-        for y in 0..tile.height {
-            let dst = ((tile.y0 as u32 + y as u32 - self.top) * self.width) as usize;
+        for y in 0..tile.bounds.height {
+            let dst = ((tile.bounds.y0 as u32 + y as u32 - self.top) * self.width) as usize;
             tile.add_row(y as usize, &mut self.sums[dst..dst + self.width as usize]);
         }
         self.invalid_samples += tile.invalid_samples;
@@ -477,10 +462,10 @@ impl Film {
         let (top, held) = (self.top as i32, self.rows() as i32);
         for tile in tiles {
             assert!(
-                tile.y0 >= top && tile.y0 + tile.height <= top + held,
+                tile.bounds.y0 >= top && tile.bounds.y0 + tile.bounds.height <= top + held,
                 "tile rows {}..{} outside the film's rows {top}..{}",
-                tile.y0,
-                tile.y0 + tile.height,
+                tile.bounds.y0,
+                tile.bounds.y0 + tile.bounds.height,
                 top + held
             );
         }
@@ -490,8 +475,8 @@ impl Film {
             .for_each(|(r, row)| {
                 let y = top + r as i32;
                 for tile in tiles {
-                    if (tile.y0..tile.y0 + tile.height).contains(&y) {
-                        tile.add_row((y - tile.y0) as usize, row);
+                    if (tile.bounds.y0..tile.bounds.y0 + tile.bounds.height).contains(&y) {
+                        tile.add_row((y - tile.bounds.y0) as usize, row);
                     }
                 }
             });
