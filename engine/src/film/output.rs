@@ -124,31 +124,17 @@ pub fn read(path: impl AsRef<Path>) -> Result<Image, ImageError> {
     if is_exr {
         return read_exr(path);
     }
-    let reader = image::ImageReader::open(path)
-        .and_then(|r| r.with_guessed_format())
-        .map_err(|e| io_error(path, e))?;
-    let linear = reader.format() == Some(image::ImageFormat::Hdr);
-    let decoded = reader.decode().map_err(|e| {
-        io_error(
+    let texels = radiant_textures::load_image(path, false).map_err(|e| match e {
+        radiant_textures::LoadError::Read { message, .. } => io_error(
             path,
-            format!("{e} (Radiant reads EXR, Radiance HDR, PNG and JPEG images)"),
-        )
+            format!("{message} (Radiant reads EXR, Radiance HDR, PNG and JPEG images)"),
+        ),
+        other => io_error(path, other),
     })?;
-    let rgb = decoded.to_rgb32f();
-    let decode = |c: f32| {
-        if linear {
-            c
-        } else {
-            radiant_textures::srgb_to_linear(c)
-        }
-    };
     Ok(Image {
-        width: rgb.width(),
-        height: rgb.height(),
-        pixels: rgb
-            .pixels()
-            .map(|p| radiant_core::Rgb::from(p.0.map(decode)))
-            .collect(),
+        width: texels.width,
+        height: texels.height,
+        pixels: texels.data,
     })
 }
 

@@ -99,7 +99,11 @@ fn load_exr(path: &Path) -> Result<Texels, LoadError> {
 /// the decoded RGBA floats, their RGB float copy and the texels.
 const DECODE_BYTES: u64 = 16 + 12 + 12;
 
-fn load_image(path: &Path, raw: bool) -> Result<Texels, LoadError> {
+/// Reads a PNG, JPEG or Radiance HDR file (its format told by its
+/// content) into linear texels; `raw` skips the sRGB decoding of integer
+/// formats. [`load`] reads textures through it, and `radiant compare`
+/// the images it is given.
+pub fn load_image(path: &Path, raw: bool) -> Result<Texels, LoadError> {
     radiant_core::input_file::reject_special_file(path).map_err(|e| read_error(path, e))?;
     let reader = || {
         image::ImageReader::open(path)
