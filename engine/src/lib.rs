@@ -62,5 +62,6 @@ pub fn builtin_registry() -> Registry {
     radiant_samplers::register(&mut registry);
     radiant_textures::register(&mut registry);
     radiant_media::register(&mut registry);
+    integrators::module::register(&mut registry);
     registry
 }

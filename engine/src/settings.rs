@@ -38,6 +38,9 @@ pub struct RenderSettings {
     /// How the image's values are written (`film: {tonemap, bit_depth,
     /// exr, jpeg_quality}`).
     pub output: Encoding,
+    /// Adaptive sampling (`sampler: {adaptive: …}`), if on: `spp` is then
+    /// the most a pixel takes unless `max_spp` says otherwise.
+    pub adaptive: Option<crate::integrators::adaptive::Adaptive>,
 }
 
 impl Default for RenderSettings {
@@ -54,6 +57,7 @@ impl Default for RenderSettings {
             light_selection: LightSelection::default(),
             filter_sampling: FilterSampling::default(),
             output: Encoding::default(),
+            adaptive: None,
         }
     }
 }

@@ -1,6 +1,12 @@
-//! The CPU backend: the frame is cut into tiles, each tile's samples are
-//! rendered as wavefront batches on a rayon worker, and tile films are
-//! merged in tile order (so results do not depend on the thread count).
+//! The CPU backend: the drivers of the integrator families
+//! ([`crate::integrators::module`]). For a tile integrator the frame is cut
+//! into tiles, each tile's samples are rendered as batches by the
+//! integrator's worker on a rayon thread, and tile films are merged in
+//! tile order (so results do not depend on the thread count); splatting
+//! tile integrators also get a whole-image [`SplatFilm`], and under
+//! adaptive sampling each tile runs its own rounds
+//! ([`crate::integrators::adaptive`]). A Markov-chain integrator renders
+//! the whole frame into a [`SplatFilm`] itself.
 //! Tiles are rendered a group of tile rows at a time. [`render_rows`]
 //! holds only the band of film rows a group reaches
 //! ([`film::band`](crate::film::band)) and hands finished rows to a row
@@ -14,8 +20,11 @@ use crate::film::aov::{AovFilm, AovImage, AovTile};
 use crate::film::band::Bands;
 use crate::film::encode::{RowSink, write_encoded};
 use crate::film::memory::FrameTooLarge;
-use crate::film::{Film, Reconstruction, TileFilm};
-use crate::integrators::path::{Batch, Wavefront};
+use crate::film::{Film, Image, Reconstruction, TileFilm};
+use crate::integrators::{
+    Batch, ChainContext, Family, SplatFilm, TileContext, TileIntegrator, TileOutput, TileWorker,
+};
+use radiant_core::Rgb;
 use rayon::prelude::*;
 use std::ops::Range;
 use std::path::Path;
@@ -49,16 +58,111 @@ pub fn render(scene: &RenderScene, progress: &Progress<'_>) -> Rendered {
 /// its film cannot be allocated (before any sample is traced).
 pub fn try_render(scene: &RenderScene, progress: &Progress<'_>) -> Result<Rendered, FrameTooLarge> {
     let s = &scene.settings;
+    let tiles = match scene.integrator.family() {
+        Family::Tiles(tiles) => tiles,
+        Family::Chains(chains) => {
+            let splats = SplatFilm::new(s.width, s.height, scene.filter.as_ref())?;
+            let start = Instant::now();
+            let pass = chains.render(&ChainContext {
+                scene,
+                spp: s.spp,
+                splats: &splats,
+                progress,
+            });
+            let mut image = black_image(s.width, s.height)?;
+            splats.add_to(&mut image, pass.scale);
+            return Ok(Rendered {
+                image,
+                time: start.elapsed(),
+                samples: pass.samples,
+                rays: pass.rays,
+                invalid_samples: splats.invalid_samples(),
+            });
+        }
+    };
     let mut film = Film::try_new(s.width, s.height)?;
-    let pass = render_samples(scene, &mut film, 0..s.spp, progress);
-    let image = film.try_develop()?;
+    let splats = frame_splats(scene, tiles)?;
+    let pass = Tiler::new(scene, tiles, splats.as_ref(), 0..s.spp, progress)
+        .whole(Tiler::render, |tiles| film.merge_all(tiles));
+    let mut image = film.try_develop()?;
+    let invalid_splats = add_splats(splats.as_ref(), &mut image, pass.samples);
     Ok(Rendered {
         image,
         time: pass.time,
         samples: pass.samples,
         rays: pass.rays,
-        invalid_samples: film.invalid_samples,
+        invalid_samples: film.invalid_samples + invalid_splats,
     })
+}
+
+/// A black image of `width × height`, or what the frame needed.
+fn black_image(width: u32, height: u32) -> Result<Image, FrameTooLarge> {
+    let pixels = crate::film::memory::try_filled(width as usize * height as usize, Rgb::ZERO)
+        .ok_or_else(|| FrameTooLarge::new(width, height))?;
+    Ok(Image {
+        width,
+        height,
+        pixels,
+    })
+}
+
+/// The whole-image splat film of a frame rendered by `tiles`, where it
+/// splats.
+fn frame_splats(
+    scene: &RenderScene,
+    tiles: &dyn TileIntegrator,
+) -> Result<Option<SplatFilm>, FrameTooLarge> {
+    let s = &scene.settings;
+    tiles
+        .splats()
+        .then(|| SplatFilm::new(s.width, s.height, scene.filter.as_ref()))
+        .transpose()
+}
+
+/// Adds `splats` to `image`, scaled by the pixels over the camera samples
+/// `samples` (one light path per camera sample, so 1 / spp at a fixed
+/// spp); returns the invalid splats.
+fn add_splats(splats: Option<&SplatFilm>, image: &mut Image, samples: u64) -> u64 {
+    let Some(splats) = splats else {
+        return 0;
+    };
+    let pixels = image.width as f64 * image.height as f64;
+    splats.add_to(image, pixels / samples.max(1) as f64);
+    splats.invalid_samples()
+}
+
+/// The tile integrator of `scene` where it renders in passes of sample
+/// ranges — a tile integrator that does not splat, without adaptive
+/// sampling — or why it cannot: `--time`, `--checkpoint`, `--resume` and
+/// `--partition` render in passes, and the banded writer needs the same.
+pub fn passes(scene: &RenderScene) -> Result<&dyn TileIntegrator, RenderError> {
+    let refuse = |why: &str| {
+        Err(RenderError::NoPasses(format!(
+            "{why}; `--time`, `--checkpoint`, `--resume`, `--partition` and `radiant merge` need              renders in passes of whole samples of every pixel"
+        )))
+    };
+    let name = integrator_name(scene);
+    match scene.integrator.family() {
+        Family::Chains(_) => refuse(&format!(
+            "the integrator `{name}` runs Markov chains over the whole image"
+        )),
+        Family::Tiles(t) if t.splats() => refuse(&format!(
+            "the integrator `{name}` splats light paths over the whole image"
+        )),
+        Family::Tiles(_) if scene.settings.adaptive.is_some() => {
+            refuse("adaptive sampling decides per pixel over the whole render")
+        }
+        Family::Tiles(t) => Ok(t),
+    }
+}
+
+/// The scene's integrator type, for messages.
+pub fn integrator_name(scene: &RenderScene) -> &str {
+    scene
+        .modules
+        .iter()
+        .find(|(kind, _)| *kind == radiant_core::ModuleKind::Integrator)
+        .map_or("path", |(_, name)| name.as_str())
 }
 
 /// Renders `scene` as [`try_render`] does (the same image, bit for bit)
@@ -71,15 +175,43 @@ pub fn render_with_aovs(
     progress: &Progress<'_>,
 ) -> Result<(Rendered, AovImage), FrameTooLarge> {
     let s = &scene.settings;
+    let Family::Tiles(tiles) = scene.integrator.family() else {
+        // A Markov-chain render has no camera rays of its own: its
+        // output variables are those of the camera's first hits, rendered
+        // with `path`'s camera rays alone.
+        let rendered = try_render(scene, progress)?;
+        let mut aovs = AovFilm::try_new(s.width, s.height)?;
+        let path = crate::integrators::module::PathIntegrator;
+        Tiler::new(scene, &path, None, 0..s.spp.min(4), &Progress::none()).whole(
+            Tiler::render_aovs,
+            |tiles| {
+                for (_, aov) in tiles {
+                    aovs.merge(aov);
+                }
+            },
+        );
+        return Ok((rendered, aovs.develop()));
+    };
     let mut film = Film::try_new(s.width, s.height)?;
     let mut aovs = AovFilm::try_new(s.width, s.height)?;
-    let pass = render_samples_with_aovs(scene, &mut film, &mut aovs, 0..s.spp, progress);
+    let splats = frame_splats(scene, tiles)?;
+    let pass = Tiler::new(scene, tiles, splats.as_ref(), 0..s.spp, progress).whole(
+        Tiler::render_aovs,
+        |tiles| {
+            for (tile, aov) in tiles {
+                film.merge(tile);
+                aovs.merge(aov);
+            }
+        },
+    );
+    let mut image = film.try_develop()?;
+    let invalid_splats = add_splats(splats.as_ref(), &mut image, pass.samples);
     let rendered = Rendered {
-        image: film.try_develop()?,
+        image,
         time: pass.time,
         samples: pass.samples,
         rays: pass.rays,
-        invalid_samples: film.invalid_samples,
+        invalid_samples: film.invalid_samples + invalid_splats,
     };
     Ok((rendered, aovs.develop()))
 }
@@ -87,6 +219,10 @@ pub fn render_with_aovs(
 /// [`render_samples`] that also adds the camera rays' first hits to
 /// `aovs` (whole films both): progressive rendering of the image and its
 /// output variables.
+///
+/// # Panics
+///
+/// Where the scene does not render in passes ([`passes`]).
 pub fn render_samples_with_aovs(
     scene: &RenderScene,
     film: &mut Film,
@@ -94,7 +230,8 @@ pub fn render_samples_with_aovs(
     samples: Range<u32>,
     progress: &Progress<'_>,
 ) -> Pass {
-    Tiler::new(scene, samples, progress).whole(Tiler::render_aovs, |tiles| {
+    let tiles = passes(scene).unwrap_or_else(|e| panic!("{e}"));
+    Tiler::new(scene, tiles, None, samples, progress).whole(Tiler::render_aovs, |tiles| {
         for (tile, aov) in tiles {
             film.merge(tile);
             aovs.merge(aov);
@@ -113,6 +250,14 @@ pub fn write(
     progress: &Progress<'_>,
 ) -> Result<Written, RenderError> {
     let s = &scene.settings;
+    if passes(scene).is_err() {
+        // Splats and adaptive decisions reach the whole image: render it
+        // whole, then write it.
+        FrameTooLarge::new(s.width, s.height).check()?;
+        let rendered = try_render(scene, progress)?;
+        crate::film::output::write_encoded(path, &rendered.image, &s.output)?;
+        return Ok(Written::from(&rendered));
+    }
     let group = band_tile_rows(scene);
     write_encoded(path, &s.output, s.width, s.height, |rows| {
         render_rows(scene, rows, group, progress)
@@ -165,13 +310,19 @@ pub fn group_tile_rows(width: u32) -> u32 {
 /// consecutive ranges (`0..4`, `4..8`, …) accumulates the same image as
 /// one render of all of them, so a caller can develop the film between
 /// passes and watch the estimate converge.
+///
+/// # Panics
+///
+/// Where the scene does not render in passes ([`passes`]).
 pub fn render_samples(
     scene: &RenderScene,
     film: &mut Film,
     samples: Range<u32>,
     progress: &Progress<'_>,
 ) -> Pass {
-    Tiler::new(scene, samples, progress).whole(Tiler::render, |tiles| film.merge_all(tiles))
+    let tiles = passes(scene).unwrap_or_else(|e| panic!("{e}"));
+    Tiler::new(scene, tiles, None, samples, progress)
+        .whole(Tiler::render, |tiles| film.merge_all(tiles))
 }
 
 /// Renders every sample of `scene` in groups of `group` tile rows and
@@ -188,7 +339,8 @@ pub fn render_rows(
 ) -> Result<Written, RenderError> {
     let start = Instant::now();
     let s = &scene.settings;
-    let tiler = Tiler::new(scene, 0..s.spp, progress);
+    let tiles = passes(scene)?;
+    let tiler = Tiler::new(scene, tiles, None, 0..s.spp, progress);
     let bands = tiler.bands(group);
     let threads = rayon::current_num_threads();
     // A thread's first allocation makes glibc reserve it an arena of
@@ -229,6 +381,9 @@ pub fn render_rows(
 /// indices, reporting progress as batches finish.
 struct Tiler<'a> {
     scene: &'a RenderScene,
+    integrator: &'a dyn TileIntegrator,
+    /// The frame's splat film, where the integrator splats.
+    splats: Option<&'a SplatFilm>,
     reconstruction: Reconstruction,
     samples: Range<u32>,
     /// Camera paths of the whole pass.
@@ -239,10 +394,18 @@ struct Tiler<'a> {
 }
 
 impl<'a> Tiler<'a> {
-    fn new(scene: &'a RenderScene, samples: Range<u32>, progress: &'a Progress<'a>) -> Self {
+    fn new(
+        scene: &'a RenderScene,
+        integrator: &'a dyn TileIntegrator,
+        splats: Option<&'a SplatFilm>,
+        samples: Range<u32>,
+        progress: &'a Progress<'a>,
+    ) -> Self {
         let s = &scene.settings;
         Self {
             scene,
+            integrator,
+            splats,
             reconstruction: Reconstruction::new(scene.filter.as_ref(), s.filter_sampling),
             total: s.width as u64 * s.height as u64 * samples.len() as u64,
             samples,
@@ -290,9 +453,10 @@ impl<'a> Tiler<'a> {
             .collect();
         let results: Vec<(TileFilm, u64)> = tiles
             .par_iter()
-            .map_init(Wavefront::default, |wave, &tile| {
-                self.tile(wave, tile, None)
-            })
+            .map_init(
+                || self.integrator.worker(),
+                |worker, &tile| self.tile(worker.as_mut(), tile, None),
+            )
             .collect();
         let rays = results.iter().map(|(_, r)| r).sum();
         (results.into_iter().map(|(tile, _)| tile).collect(), rays)
@@ -309,14 +473,17 @@ impl<'a> Tiler<'a> {
             .collect();
         let results: Vec<(TileFilm, AovTile, u64)> = tiles
             .par_iter()
-            .map_init(Wavefront::default, |wave, &(x0, y0)| {
-                let (x1, y1) = ((x0 + TILE).min(s.width), (y0 + TILE).min(s.height));
-                let size = (s.width, s.height);
-                let reach = self.reconstruction.reach();
-                let mut aovs = AovTile::new(x0, y0, x1, y1, size, reach);
-                let (tile, rays) = self.tile(wave, (x0, y0), Some(&mut aovs));
-                (tile, aovs, rays)
-            })
+            .map_init(
+                || self.integrator.worker(),
+                |worker, &(x0, y0)| {
+                    let (x1, y1) = ((x0 + TILE).min(s.width), (y0 + TILE).min(s.height));
+                    let size = (s.width, s.height);
+                    let reach = self.reconstruction.reach();
+                    let mut aovs = AovTile::new(x0, y0, x1, y1, size, reach);
+                    let (tile, rays) = self.tile(worker.as_mut(), (x0, y0), Some(&mut aovs));
+                    (tile, aovs, rays)
+                },
+            )
             .collect();
         let rays = results.iter().map(|(_, _, r)| r).sum();
         let tiles = results.into_iter().map(|(t, a, _)| (t, a)).collect();
@@ -327,7 +494,7 @@ impl<'a> Tiler<'a> {
     /// camera rays' first hits to `aovs` where given.
     fn tile(
         &self,
-        wave: &mut Wavefront,
+        worker: &mut dyn TileWorker,
         (x0, y0): (u32, u32),
         mut aovs: Option<&mut AovTile>,
     ) -> (TileFilm, u64) {
@@ -336,7 +503,8 @@ impl<'a> Tiler<'a> {
         let pixels = (x1 - x0) * (y1 - y0);
         let chunk = (BATCH_PATHS / pixels).max(1);
         let mut tile = TileFilm::new(x0, y0, x1, y1, (w, h), self.reconstruction.reach());
-        let rays_before = wave.rays;
+        let rays_before = worker.rays();
+        let ctx = self.context();
         let mut first = self.samples.start;
         while first < self.samples.end {
             let count = chunk.min(self.samples.end - first);
@@ -348,12 +516,12 @@ impl<'a> Tiler<'a> {
                 first_sample: first,
                 samples: count,
             };
-            match aovs.as_deref_mut() {
-                Some(a) => {
-                    wave.render_with_aovs(self.scene, batch, &self.reconstruction, &mut tile, a)
-                }
-                None => wave.render(self.scene, batch, &self.reconstruction, &mut tile),
-            }
+            let out = TileOutput {
+                film: &mut tile,
+                aovs: aovs.as_deref_mut(),
+                samples: None,
+            };
+            worker.render(&ctx, batch, out);
             first += count;
             if self.progress.is_active() {
                 let n = pixels as u64 * count as u64;
@@ -361,7 +529,16 @@ impl<'a> Tiler<'a> {
                 self.progress.report(d, self.total);
             }
         }
-        (tile, wave.rays - rays_before)
+        (tile, worker.rays() - rays_before)
+    }
+
+    /// What every batch of the frame shares.
+    fn context(&self) -> TileContext<'_> {
+        TileContext {
+            scene: self.scene,
+            reconstruction: &self.reconstruction,
+            splats: self.splats,
+        }
     }
 }
 
@@ -484,6 +661,44 @@ pub(crate) mod tests {
         assert_eq!(std::fs::read_dir(dir.path()).expect("listed").count(), 0);
         on_threads(1, || write(&r, &out, &Progress::none())).expect("written");
         assert!(out.exists());
+    }
+
+    #[test]
+    fn path_through_the_integrator_module_is_the_wavefront_driven_directly() {
+        // The driver before integrators were modules: 16-pixel tiles,
+        // batches of about 1024 paths through `Wavefront::render`, tiles
+        // merged in order. The module's driver must give the same bits.
+        use crate::integrators::path::Wavefront;
+        let (w, h, spp) = (40, 37, 12);
+        let r = cornell_scene(w, h, spp);
+        let module = on_threads(2, || render(&r, &Progress::none()).image);
+        let recon = Reconstruction::new(r.filter.as_ref(), r.settings.filter_sampling);
+        let mut film = Film::new(w, h);
+        let mut wave = Wavefront::default();
+        for y0 in (0..h).step_by(16) {
+            for x0 in (0..w).step_by(16) {
+                let (x1, y1) = ((x0 + 16).min(w), (y0 + 16).min(h));
+                let mut tile = TileFilm::new(x0, y0, x1, y1, (w, h), recon.reach());
+                let chunk = (1024 / ((x1 - x0) * (y1 - y0))).max(1);
+                let mut first = 0;
+                while first < spp {
+                    let samples = chunk.min(spp - first);
+                    let batch = Batch {
+                        x0,
+                        y0,
+                        x1,
+                        y1,
+                        first_sample: first,
+                        samples,
+                    };
+                    wave.render(&r, batch, &recon, &mut tile);
+                    first += samples;
+                }
+                film.merge(&tile);
+            }
+        }
+        assert!(film.develop().pixels == module.pixels);
+        assert!(module.mean() > 0.0);
     }
 
     #[test]

@@ -108,6 +108,10 @@ pub enum RenderError {
     /// The GPU failed or cannot render the scene.
     #[error(transparent)]
     Gpu(#[from] gpu::GpuError),
+    /// The render was asked in passes, and the integrator or adaptive
+    /// sampling cannot render that way.
+    #[error("{0}")]
+    NoPasses(String),
 }
 
 /// Something that renders frames: the CPU path tracer or the GPU one.
@@ -185,6 +189,7 @@ impl Backend for CpuBackend {
         samples: Range<u32>,
         progress: &Progress<'_>,
     ) -> Result<cpu::Pass, RenderError> {
+        cpu::passes(scene)?;
         Ok(cpu::render_samples(scene, film, samples, progress))
     }
 

@@ -154,6 +154,9 @@ pub struct RenderScene {
     pub filter: Box<dyn Filter>,
     /// The sampler.
     pub sampler: Box<dyn Sampler>,
+    /// The integrator (`integrator: {type: …}`), which the backend's
+    /// driver for its family renders with.
+    pub integrator: Box<dyn crate::integrators::Integrator>,
     /// The textures.
     pub textures: TextureTable,
     /// The participating media (empty for scenes without any).

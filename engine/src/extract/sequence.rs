@@ -16,7 +16,8 @@ use crate::error::SceneError;
 use crate::settings::RenderSettings;
 use crate::world::{CameraMotion, Scene, Trs, systems};
 use glam::{DMat4, DVec3};
-use radiant_core::{Effects, Registry};
+use radiant_core::{Effects, ModuleKind, Registry};
+use std::collections::BTreeSet;
 use std::time::{Duration, Instant};
 
 /// How a sequence renders its frames.
@@ -196,6 +197,7 @@ pub(super) fn build(
     let (modules, mut initial) =
         ModuleState::build(scene, registry, &settings, render_origin, emitters, sphere)?;
     let media = super::MediaTable::build(scene, registry, &initial.shaders, &mut initial.modules)?;
+    let integrator = build_integrator(scene, registry, &mut initial.modules)?;
     let mut render = RenderScene {
         settings,
         frame,
@@ -217,6 +219,7 @@ pub(super) fn build(
         render_origin,
         filter: initial.filter,
         sampler: initial.sampler,
+        integrator,
         textures: initial.textures,
         media,
         effects: Effects::empty(),
@@ -233,6 +236,24 @@ pub(super) fn build(
         start: timeline.start,
         render_origin,
     })
+}
+
+/// The scene's integrator, built through the registry (an unknown type
+/// is an error listing the registered ones, at the `type`'s location).
+fn build_integrator(
+    scene: &Scene,
+    registry: &Registry,
+    modules: &mut BTreeSet<(ModuleKind, String)>,
+) -> Result<Box<dyn crate::integrators::Integrator>, SceneError> {
+    let spec = &scene.integrator;
+    let mut textures = radiant_core::TextureTable::default();
+    let names = std::collections::HashMap::new();
+    let mut ctx = radiant_core::BuildContext::standalone(&scene.dir, &mut textures, &names);
+    let integrator = registry
+        .build::<dyn crate::integrators::Integrator>(&spec.type_name, &spec.params, &mut ctx)
+        .map_err(|e| crate::error::module_error(&scene.file, spec, e))?;
+    modules.insert((ModuleKind::Integrator, spec.type_name.clone()));
+    Ok(integrator)
 }
 
 /// The frame's effect set: what its modules declare, and motion blur where

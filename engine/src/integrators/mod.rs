@@ -4,8 +4,23 @@
 //! paths advances one bounce at a time through the stages generate → trace
 //! → emission → sort by material → shade → next-event estimation → shadow
 //! rays → continue/compact, and finally splats into the film.
+//!
+//! [`module`] makes integrators a module kind (`integrator: {type: …}`,
+//! registered in the [`Registry`](radiant_core::Registry)) with a driver
+//! per family — image tiles, Markov chains — and [`splat`] is the
+//! whole-image film that light paths and chains splat into; [`adaptive`]
+//! stops sampling converged pixels in the tile driver.
 
+pub mod adaptive;
 mod medium;
+pub mod module;
 pub mod path;
 mod sort;
+pub mod splat;
 pub mod surface;
+
+pub use module::{
+    Batch, ChainContext, ChainIntegrator, ChainPass, Family, Integrator, TileContext,
+    TileIntegrator, TileOutput, TileWorker,
+};
+pub use splat::SplatFilm;

@@ -247,6 +247,15 @@ impl Wavefront {
         self.render_batch(scene, batch, reconstruction, tile, Some(aovs));
     }
 
+    /// The last batch's camera samples: (pixel index, value) per path.
+    pub fn samples(&self) -> impl Iterator<Item = (u32, Rgb)> + '_ {
+        let n = self.ids.len().min(self.radiance.len());
+        self.ids[..n]
+            .iter()
+            .zip(&self.radiance[..n])
+            .map(|(id, value)| (id.pixel, *value))
+    }
+
     fn render_batch(
         &mut self,
         scene: &RenderScene,

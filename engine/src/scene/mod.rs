@@ -38,6 +38,7 @@ pub mod transform;
 mod yaml;
 
 pub use crate::error::SceneError;
+pub use crate::integrators::adaptive::Adaptive;
 pub use crate::settings::{FilterSampling, LightSelection, MAX_FILM_SIZE, RenderSettings};
 pub use crate::world::{Scene, Timeline};
 pub use instances::MAX_INSTANCES;
@@ -73,7 +74,6 @@ const TOP_KEYS: &[&str] = &[
     "atmosphere",
 ];
 const SHAPE_TYPES: &[&str] = &["rectangle", "cube", "sphere", "mesh", "gltf"];
-const INTEGRATORS: &[&str] = &["path"];
 
 /// Loads the scene file at `path`.
 pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
@@ -109,9 +109,9 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
     let mut top = Mapping::new(file, &doc, "scene")?;
     let mut world = World::new();
 
-    let (max_depth, rr_depth, light_selection) = parse_integrator(file, top.get("integrator"))?;
+    let (integrator_keys, integrator) = parse_integrator(file, top.get("integrator"))?;
     let (film, filter) = parse_film(file, top.get("film"))?;
-    let (spp, sampler) = parse_sampler(file, top.get("sampler"))?;
+    let (spp, adaptive, sampler) = parse_sampler(file, top.get("sampler"))?;
     let (fps, frames) = parse_animation(file, top.get("animation"))?;
 
     let mut loader = Loader {
@@ -191,13 +191,15 @@ pub fn from_str(text: &str, file: &Path, dir: &Path) -> Result<Scene, SceneError
             width: film.width,
             height: film.height,
             spp,
-            max_depth,
-            rr_depth,
+            max_depth: integrator_keys.max_depth,
+            rr_depth: integrator_keys.rr_depth,
             seed: 0,
-            light_selection,
+            light_selection: integrator_keys.light_selection,
             filter_sampling: film.filter_sampling,
             output: film.encoding,
+            adaptive,
         },
+        integrator,
         timeline,
         frame: timeline.start,
         filter,
@@ -531,6 +533,10 @@ fn parse_shutter(file: &Path, node: &Node) -> Result<(f64, f64), SceneError> {
     Ok((open, close))
 }
 
+/// The integrator keys every integrator shares, read by the loader (the
+/// integrator module parses the rest).
+pub(crate) const INTEGRATOR_KEYS: &[&str] = &["max_depth", "rr_depth", "light_selection"];
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct IntegratorParams {
@@ -550,32 +556,46 @@ fn five() -> u32 {
     5
 }
 
+/// The scene's `integrator:`: the keys every integrator shares, and the
+/// module (its type is checked against the registry at extract).
 fn parse_integrator(
     file: &Path,
     node: Option<&marked_yaml::Node>,
-) -> Result<(i32, u32, LightSelection), SceneError> {
+) -> Result<(IntegratorParams, ModuleSpec), SceneError> {
     let Some(node) = node else {
-        return Ok((-1, 5, LightSelection::default()));
+        let default = crate::integrators::module::DEFAULT;
+        return Ok((
+            IntegratorParams {
+                max_depth: -1,
+                rr_depth: 5,
+                light_selection: LightSelection::default(),
+            },
+            default_module(default),
+        ));
     };
-    let spec = ModuleSpec::from_node(file, node, "integrator", &[])?;
-    if !INTEGRATORS.contains(&spec.type_name.as_str()) {
-        return Err(unknown_type(file, &spec, "integrator", INTEGRATORS));
+    let spec = ModuleSpec::from_node(file, node, "integrator", INTEGRATOR_KEYS)?;
+    let mut keys = marked_yaml::types::MarkedMappingNode::new_empty(*node.span());
+    for (k, v) in node.as_mapping().into_iter().flat_map(|m| m.iter()) {
+        if INTEGRATOR_KEYS.contains(&k.as_str()) {
+            keys.insert(k.clone(), v.clone());
+        }
     }
-    let p: IntegratorParams = spec
-        .params
-        .parse()
-        .map_err(|e| SceneError::from_param(file, e))?;
+    let p: IntegratorParams = parse_node(file, &marked_yaml::Node::Mapping(keys))?;
     if p.max_depth < -1 {
         return Err(SceneError::new(
             file,
-            spec.params.location_of("max_depth"),
+            spec.params.location_of("max_depth").or_else(|| {
+                node.as_mapping()
+                    .and_then(|m| m.get_node("max_depth"))
+                    .and_then(|n| loc(n.span()))
+            }),
             format!(
                 "max_depth must be -1 (unlimited) or at least 0, found {}",
                 p.max_depth
             ),
         ));
     }
-    Ok((p.max_depth, p.rr_depth, p.light_selection))
+    Ok((p, spec))
 }
 
 #[derive(Deserialize)]
@@ -747,11 +767,12 @@ fn default_spp() -> u32 {
 fn parse_sampler(
     file: &Path,
     node: Option<&marked_yaml::Node>,
-) -> Result<(u32, ModuleSpec), SceneError> {
+) -> Result<(u32, Option<Adaptive>, ModuleSpec), SceneError> {
     let Some(node) = node else {
-        return Ok((default_spp(), default_module("independent")));
+        return Ok((default_spp(), None, default_module("independent")));
     };
-    let spec = ModuleSpec::from_node(file, node, "sampler", &["spp"])?;
+    let spec = ModuleSpec::from_node(file, node, "sampler", &["spp", "adaptive"])?;
+    let adaptive = parse_adaptive(file, node)?;
     let mut keys = marked_yaml::types::MarkedMappingNode::new_empty(*node.span());
     let spp = node
         .as_mapping()
@@ -775,7 +796,30 @@ fn parse_sampler(
         keys.insert(k.clone(), v.clone());
     }
     let p: SamplerKeys = parse_node(file, &marked_yaml::Node::Mapping(keys))?;
-    Ok((p.spp, spec))
+    Ok((p.spp, adaptive, spec))
+}
+
+/// The sampler's `adaptive: {threshold, confidence, batch, min_spp,
+/// max_spp}` (or `adaptive: true` for the defaults), if given.
+fn parse_adaptive(file: &Path, sampler: &Node) -> Result<Option<Adaptive>, SceneError> {
+    let Some(node) = sampler.as_mapping().and_then(|m| m.get_node("adaptive")) else {
+        return Ok(None);
+    };
+    if let Some(on) = node
+        .as_scalar()
+        .and_then(|s| s.as_str().parse::<bool>().ok())
+    {
+        return Ok(on.then(Adaptive::default));
+    }
+    let a: Adaptive = parse_node(file, node)?;
+    a.check().map_err(|(key, message)| {
+        let at = node
+            .as_mapping()
+            .and_then(|m| m.get_node(key))
+            .unwrap_or(node);
+        SceneError::new(file, loc(at.span()), message)
+    })?;
+    Ok(Some(a))
 }
 
 fn named_modules(
@@ -801,21 +845,6 @@ fn named_modules(
             ))
         })
         .collect()
-}
-
-fn unknown_type(file: &Path, spec: &ModuleSpec, what: &str, known: &[&str]) -> SceneError {
-    let hint = closest(&spec.type_name, known)
-        .map(|s| format!(" (did you mean `{s}`?)"))
-        .unwrap_or_default();
-    SceneError::new(
-        file,
-        spec.location,
-        format!(
-            "unknown {what} type `{}`{hint}; known {what} types: {}",
-            spec.type_name,
-            known.join(", ")
-        ),
-    )
 }
 
 struct ShapeDef {

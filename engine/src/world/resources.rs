@@ -99,6 +99,9 @@ pub struct Scene {
     pub world: World,
     /// Integrator, film and sampler settings.
     pub settings: RenderSettings,
+    /// The integrator module (its `type` and own keys; the keys every
+    /// integrator shares are in `settings`).
+    pub integrator: ModuleSpec,
     /// The frames and the shutter.
     pub timeline: Timeline,
     /// The frame the systems last moved the world to

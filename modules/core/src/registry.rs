@@ -26,10 +26,14 @@ use crate::{
     BuildContext, Camera, Filter, Light, Medium, ParamError, Params, Phase, Sampler, Shader,
     Texture,
 };
+use std::any::Any;
 use std::collections::BTreeMap;
 use std::fmt;
 
-/// The eight kinds of module.
+/// The kinds of module: the eight this crate defines tables for, and
+/// [`ModuleKind::Integrator`], whose trait lives in the engine (it needs the
+/// engine's render data) and whose table is an extension table
+/// ([`Registry::extension`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum ModuleKind {
     /// Generates primary rays.
@@ -48,6 +52,8 @@ pub enum ModuleKind {
     Medium,
     /// Scatters light in a medium (a phase function).
     Phase,
+    /// Computes light transport: the algorithm that renders the frame.
+    Integrator,
 }
 
 impl fmt::Display for ModuleKind {
@@ -61,6 +67,7 @@ impl fmt::Display for ModuleKind {
             ModuleKind::Texture => "texture",
             ModuleKind::Medium => "medium",
             ModuleKind::Phase => "phase",
+            ModuleKind::Integrator => "integrator",
         })
     }
 }
@@ -110,9 +117,41 @@ pub struct Table<T: ?Sized> {
 
 impl<T: ?Sized> Default for Table<T> {
     fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<T: ?Sized> Table<T> {
+    /// A table with no types (`const`, so that a [`ModuleType`] whose
+    /// table is an extension can return a static empty one before anything
+    /// registered).
+    pub const fn new() -> Self {
         Self {
             entries: BTreeMap::new(),
         }
+    }
+}
+
+/// An extension table as the registry holds it: its documentation for
+/// [`Registry::modules`], and the table itself for a downcast.
+trait Extension: Send + Sync {
+    fn infos(&self) -> Vec<ModuleInfo>;
+    fn as_any(&self) -> &dyn Any;
+    fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+impl<T: ?Sized + 'static> Extension for Table<T>
+where
+    Table<T>: Send + Sync,
+{
+    fn infos(&self) -> Vec<ModuleInfo> {
+        self.entries.values().map(|(info, _)| *info).collect()
+    }
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
     }
 }
 
@@ -142,6 +181,9 @@ macro_rules! module_types {
         #[derive(Default)]
         pub struct Registry {
             $($field: Table<dyn $t>,)*
+            /// Tables of kinds whose trait lives outside this crate (the
+            /// engine's integrators), by kind.
+            extensions: BTreeMap<ModuleKind, Box<dyn Extension>>,
         }
         $(
             impl ModuleType for dyn $t {
@@ -155,6 +197,10 @@ macro_rules! module_types {
             pub fn modules(&self) -> Vec<(ModuleKind, ModuleInfo)> {
                 let mut all = Vec::new();
                 $(all.extend(self.$field.entries.values().map(|(info, _)| (ModuleKind::$kind, *info)));)*
+                for (kind, table) in &self.extensions {
+                    all.extend(table.infos().into_iter().map(|info| (*kind, info)));
+                }
+                all.sort_by_key(|(kind, _)| *kind);
                 all
             }
         }
@@ -192,6 +238,38 @@ impl Registry {
         T::table_mut(self)
             .entries
             .insert(info.type_name, (info, Box::new(build)));
+    }
+
+    /// The table of kind `T` where `T` is an extension kind (one whose
+    /// trait another crate defines: the engine's `dyn Integrator`), or
+    /// `None` before anything of that kind registered. Such a kind's
+    /// [`ModuleType::table`] returns this or a static empty table, and its
+    /// [`ModuleType::table_mut`] returns [`Registry::extension_mut`].
+    pub fn extension<T: ModuleType + ?Sized>(&self) -> Option<&Table<T>>
+    where
+        Table<T>: Send + Sync,
+    {
+        self.extensions
+            .get(&T::KIND)
+            .and_then(|t| t.as_any().downcast_ref())
+    }
+
+    /// The table of the extension kind `T`, created empty on first use.
+    ///
+    /// # Panics
+    ///
+    /// If another trait object type already holds the table of `T::KIND`
+    /// (two crates declaring the same kind).
+    pub fn extension_mut<T: ModuleType + ?Sized>(&mut self) -> &mut Table<T>
+    where
+        Table<T>: Send + Sync,
+    {
+        self.extensions
+            .entry(T::KIND)
+            .or_insert_with(|| Box::new(Table::<T>::new()))
+            .as_any_mut()
+            .downcast_mut()
+            .unwrap_or_else(|| panic!("two module traits declare the {} kind", T::KIND))
     }
 
     /// Whether a module type of kind `T` is registered under `name`.

@@ -88,6 +88,20 @@ const CONSTANT_TEXTURE: &str =
 impl Modules {
     /// Gathers the modules of `scene`.
     pub fn new(scene: &RenderScene) -> Result<Self, GpuError> {
+        if !scene.integrator.gpu() {
+            return Err(GpuError::MissingCode {
+                kind: "integrator",
+                name: "of the scene".into(),
+                type_name: crate::backend::cpu::integrator_name(scene).into(),
+            });
+        }
+        if scene.settings.adaptive.is_some() {
+            return Err(GpuError::MissingCode {
+                kind: "sampler option",
+                name: "adaptive".into(),
+                type_name: "adaptive sampling".into(),
+            });
+        }
         let mut m = Modules {
             params: vec![0; HEADER_WORDS],
             ..Modules::default()

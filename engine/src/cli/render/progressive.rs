@@ -308,7 +308,8 @@ impl Session {
         self.asked
             || (!passes
                 && bytes <= PLAIN_FILM_BYTES
-                && FrameTooLarge::new(s.width, s.height).check().is_ok())
+                && FrameTooLarge::new(s.width, s.height).check().is_ok()
+                && radiant::backend::cpu::passes(scene).is_ok())
     }
 
     /// Renders `frame` of `args.scene` (its scene `scene`) to `path` on
