@@ -13,6 +13,7 @@
 
 pub mod adaptive;
 mod medium;
+pub mod mlt;
 pub mod module;
 pub mod path;
 mod sort;
