@@ -9,9 +9,13 @@
 //! radiant_example_module::register(&mut registry);
 //! ```
 //!
-//! and scenes can then say `type: stripes`. The texture also has a GPU
-//! side (`Texture::gpu`): its WGSL, `stripes.wgsl`, and its parameters
-//! packed as words, so scenes that use it render with `--backend gpu` too.
+//! and scenes can then say `type: stripes` (and `integrator: {type:
+//! directions}`, an example integrator: [`directions`]). The texture also
+//! has a GPU side (`Texture::gpu`): its WGSL, `stripes.wgsl`, and its
+//! parameters packed as words, so scenes that use it render with
+//! `--backend gpu` too.
+
+pub mod directions;
 
 use radiant::core::glam::Vec2;
 use radiant::core::{
@@ -92,8 +96,9 @@ const DOCS: &[ParamDoc] = &[
     },
 ];
 
-/// Registers the `stripes` texture.
+/// Registers the `stripes` texture and the `directions` integrator.
 pub fn register(registry: &mut Registry) {
+    directions::register(registry);
     registry.register::<dyn Texture>(
         ModuleInfo {
             type_name: "stripes",
