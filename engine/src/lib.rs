@@ -62,6 +62,7 @@ pub fn builtin_registry() -> Registry {
     radiant_samplers::register(&mut registry);
     radiant_textures::register(&mut registry);
     radiant_media::register(&mut registry);
+    scene::register_gltf_image(&mut registry);
     integrators::module::register(&mut registry);
     registry
 }

@@ -193,12 +193,80 @@ fn bad_requests_are_refused_before_rendering() {
         ),
     ];
     for (extra, name, message) in cases {
-        let out = dir.path().join(name);
-        let mut args = vec!["render", arg(&scene), "-o", arg(&out)];
+        assert_refused(&scene, &dir.path().join(name), extra, message);
+    }
+}
+
+/// Asserts that rendering `scene` to `out` with `extra` arguments fails
+/// with `message` and leaves no file.
+fn assert_refused(scene: &Path, out: &Path, extra: &[&str], message: &str) {
+    let mut args = vec!["render", arg(scene), "-o", arg(out)];
+    args.extend_from_slice(extra);
+    let o = radiant(&args);
+    assert!(!o.status.success(), "{extra:?} succeeded");
+    assert!(stderr(&o).contains(message), "{extra:?}: {}", stderr(&o));
+    assert!(!out.exists(), "{extra:?} left a file");
+}
+
+/// `film: {aovs: […]}` asks for the layers in the scene; `--aov` replaces
+/// the scene's list (`--aov ""` writes none); names are checked where they
+/// are written, and the scene's layers need an EXR as the flag's do.
+#[test]
+fn the_scene_asks_for_layers_with_film_aovs() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("square.yaml");
+    let with_aovs = |aovs: &str| {
+        let text = SCENE.replace(
+            "film: {width: 33, height: 33}",
+            &format!("film: {{width: 33, height: 33, aovs: {aovs}}}"),
+        );
+        assert!(text.contains("aovs"));
+        std::fs::write(&scene, text).unwrap();
+    };
+    let layers = |extra: &[&str]| {
+        let out = dir.path().join("layers.exr");
+        let _ = std::fs::remove_file(&out);
+        let mut args = vec!["render", arg(&scene), "-o", arg(&out), "--threads", "2"];
         args.extend_from_slice(extra);
         let o = radiant(&args);
-        assert!(!o.status.success(), "{extra:?} succeeded");
-        assert!(stderr(&o).contains(message), "{extra:?}: {}", stderr(&o));
-        assert!(!out.exists(), "{extra:?} left a file");
-    }
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+        let mut names: Vec<String> = channels(&out)
+            .into_keys()
+            .filter(|n| n.contains('.'))
+            .collect();
+        names.sort();
+        names
+    };
+    with_aovs("[depth, albedo]");
+    assert_eq!(
+        layers(&[]),
+        ["albedo.B", "albedo.G", "albedo.R", "depth.Z"],
+        "the scene's list"
+    );
+    assert_eq!(
+        layers(&["--aov", "normal"]),
+        ["normal.X", "normal.Y", "normal.Z"],
+        "--aov replaces the scene's list"
+    );
+    assert!(layers(&["--aov", ""]).is_empty(), "--aov \"\" writes none");
+
+    let refused = |extra: &[&str], name: &str, message: &str| {
+        assert_refused(&scene, &dir.path().join(name), extra, message);
+    };
+    refused(&[], "a.png", "film: {aovs: […]}");
+    refused(&[], "a.png", "name the output .exr");
+    refused(&["--backend", "gpu"], "a.exr", "needs the CPU backend");
+    with_aovs("[albedo, nromal]");
+    // The film line is the scene's third; `nromal` is its 46th column.
+    refused(
+        &[],
+        "a.exr",
+        "square.yaml:3:46: film aovs: unknown output variable `nromal`; expected one of albedo, normal, depth, position, spp",
+    );
+    with_aovs("{albedo: true}");
+    refused(
+        &[],
+        "a.exr",
+        "film aovs must be a list of output variable names",
+    );
 }

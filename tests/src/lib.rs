@@ -11,6 +11,17 @@ pub fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
+/// The mean of |a − b| over all channels, relative to the mean of `b`.
+pub fn relative_difference(a: &Image, b: &Image) -> f64 {
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    let (mut diff, mut sum) = (0.0f64, 0.0f64);
+    for (p, q) in a.pixels.iter().zip(&b.pixels) {
+        diff += f64::from((*p - *q).abs().element_sum());
+        sum += f64::from(q.element_sum());
+    }
+    diff / sum
+}
+
 /// Renders the scene file `scene` (relative to the workspace root) with the
 /// built-in modules.
 pub fn render_scene(scene: &str, overrides: Overrides) -> Image {

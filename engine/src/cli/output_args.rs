@@ -56,6 +56,8 @@ impl OutputArgs {
             bit_depth: self.bit_depth,
             exr: self.half.then_some(ExrSamples::Half),
             alpha: self.alpha.then_some(true),
+            // `--aov` is the passes' (`render/passes.rs`).
+            aovs: None,
         }
     }
 }

@@ -201,13 +201,15 @@ struct Totals {
 
 /// Renders as the arguments say.
 pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
-    passes::check(args)?;
+    // The flags alone first, before the scene is read; then with its keys.
+    passes::check(args, &radiant::settings::RenderSettings::default())?;
     if let Some(p) = args.partition {
         return partition::run(registry, args, p);
     }
     let pattern = args.output.to_string_lossy().contains('#');
     check_output(&frame_path(&args.output, 0))?;
     let mut scene = radiant::scene::load(&args.scene).map_err(report)?;
+    passes::check(args, &scene.settings)?;
     let progressive = progressive::start(args)?;
     let timeline = scene.timeline;
     let (first, last) = args.frames.unwrap_or((timeline.start, timeline.start));
@@ -267,7 +269,7 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
             None => backend.insert(
                 choose(
                     // First-hit planes are recorded on the CPU.
-                    if args.passes.wanted() {
+                    if args.passes.wanted(settings) {
                         BackendKind::Cpu
                     } else {
                         args.backend
@@ -307,7 +309,7 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
             );
         }
         // Alpha is the coverage plane, which the passes record.
-        let planes = args.passes.wanted() || settings.output.alpha;
+        let planes = args.passes.wanted(settings) || settings.output.alpha;
         let session = progressive.as_ref().filter(|p| p.takes(s, planes));
         let rendered = pool.install(|| {
             let progress = Progress::new(&progress);

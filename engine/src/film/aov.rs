@@ -119,6 +119,39 @@ pub fn parse_list(text: &str) -> Result<Vec<Aov>, UnknownAov> {
     Ok(list)
 }
 
+/// A set of output variables (`film.aovs`, `--aov`), listed in
+/// [`Aov::ALL`]'s order.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+pub struct AovSet(u8);
+
+impl AovSet {
+    /// Whether the set holds no variable.
+    pub fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// Whether the set holds `aov`.
+    pub fn contains(self, aov: Aov) -> bool {
+        self.0 & Self::bit(aov) != 0
+    }
+
+    /// The variables, in [`Aov::ALL`]'s order.
+    pub fn list(self) -> Vec<Aov> {
+        Aov::ALL.into_iter().filter(|a| self.contains(*a)).collect()
+    }
+
+    /// The bit of `aov`: its place among the variant (and [`Aov::ALL`]).
+    fn bit(aov: Aov) -> u8 {
+        1 << aov as u8
+    }
+}
+
+impl FromIterator<Aov> for AovSet {
+    fn from_iter<I: IntoIterator<Item = Aov>>(iter: I) -> Self {
+        Self(iter.into_iter().fold(0, |bits, a| bits | Self::bit(a)))
+    }
+}
+
 /// What a camera path's first segment found: the values of the planes for
 /// one sample (all zero for a ray that hit nothing).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

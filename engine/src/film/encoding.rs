@@ -103,6 +103,9 @@ pub struct Encoding {
     /// Whether PNG and EXR output carry the coverage as alpha
     /// ([`super::alpha`]).
     pub alpha: bool,
+    /// The output variables written as layers of EXR output
+    /// (`film: {aovs: […]}`, `--aov`; [`super::aov`]).
+    pub aovs: super::aov::AovSet,
 }
 
 /// JPEG quality when the scene gives none.
@@ -117,6 +120,7 @@ impl Default for Encoding {
             exr: ExrSamples::default(),
             jpeg_quality: DEFAULT_JPEG_QUALITY,
             alpha: false,
+            aovs: super::aov::AovSet::default(),
         }
     }
 }
@@ -134,6 +138,8 @@ pub struct OutputOverrides {
     pub exr: Option<ExrSamples>,
     /// Alpha in PNG and EXR output.
     pub alpha: Option<bool>,
+    /// The output variables (`--aov` replaces the scene's `film.aovs`).
+    pub aovs: Option<super::aov::AovSet>,
 }
 
 /// Equality is that of the fields; an override's exposure is checked to
@@ -152,6 +158,7 @@ impl Encoding {
             bit_depth: o.bit_depth.unwrap_or(self.bit_depth),
             exr: o.exr.unwrap_or(self.exr),
             alpha: o.alpha.unwrap_or(self.alpha),
+            aovs: o.aovs.unwrap_or(self.aovs),
             ..self
         })
     }

@@ -130,6 +130,12 @@ pub const SCENE_KEYS: &[KeyDocs] = &[
                 "false",
                 "Coverage as an alpha channel (RGBA PNG, straight; EXR, premultiplied).",
             ),
+            key(
+                "aovs",
+                "[albedo, normal, depth, position, spp]",
+                "[]",
+                "Output variables written as layers of the EXR (`--aov` replaces the list).",
+            ),
         ],
     },
     KeyDocs {

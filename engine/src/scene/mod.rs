@@ -41,6 +41,7 @@ pub use crate::error::SceneError;
 pub use crate::integrators::adaptive::Adaptive;
 pub use crate::settings::{FilterSampling, LightSelection, MAX_FILM_SIZE, RenderSettings};
 pub use crate::world::{Scene, Timeline};
+pub use gltf::register as register_gltf_image;
 pub use instances::MAX_INSTANCES;
 
 use crate::world::{
@@ -668,7 +669,38 @@ fn film_encoding(
         exr: p.exr,
         jpeg_quality: p.jpeg_quality,
         alpha: p.alpha,
+        // Parsed apart, with each name's location (`parse_aovs`).
+        aovs: Default::default(),
     })
+}
+
+/// `film: {aovs: [albedo, normal]}` (or the `--aov` flag's comma list as
+/// one string): each name checked where it is written.
+fn parse_aovs(
+    file: &Path,
+    node: Option<&marked_yaml::Node>,
+) -> Result<crate::film::aov::AovSet, SceneError> {
+    use crate::film::aov::{Aov, parse_list};
+    let Some(node) = node else {
+        return Ok(Default::default());
+    };
+    let items: Vec<&marked_yaml::Node> = match node {
+        marked_yaml::Node::Sequence(s) => s.iter().collect(),
+        _ => vec![node],
+    };
+    let mut set = Vec::new();
+    for item in items {
+        let located = |message: String| SceneError::new(file, loc(item.span()), message);
+        let text = item.as_scalar().ok_or_else(|| {
+            located(format!(
+                "film aovs must be a list of output variable names, such as [albedo, normal]; \
+                 the names are {}",
+                Aov::ALL.map(Aov::name).join(", ")
+            ))
+        })?;
+        set.extend(parse_list(text.as_str()).map_err(|e| located(format!("film aovs: {e}")))?);
+    }
+    Ok(set.into_iter().collect())
 }
 
 fn default_width() -> u32 {
@@ -722,6 +754,7 @@ fn parse_film(
     for key in ["tonemap", "bit_depth", "exr", "jpeg_quality", "alpha"] {
         map.get(key);
     }
+    let aovs = map.get("aovs");
     map.finish(&[
         "width",
         "height",
@@ -732,15 +765,17 @@ fn parse_film(
         "exr",
         "jpeg_quality",
         "alpha",
+        "aovs",
     ])?;
     let mut rest = marked_yaml::types::MarkedMappingNode::new_empty(*node.span());
     for (key, value) in node.as_mapping().into_iter().flat_map(|m| m.iter()) {
-        if key.as_str() != "filter" {
+        if !["filter", "aovs"].contains(&key.as_str()) {
             rest.insert(key.clone(), value.clone());
         }
     }
     let mut p: FilmParams = parse_node(file, &marked_yaml::Node::Mapping(rest))?;
     p.encoding = film_encoding(file, node, &p)?;
+    p.encoding.aovs = parse_aovs(file, aovs)?;
     for (value, key, n) in [(p.width, "width", width), (p.height, "height", height)] {
         if !(1..=MAX_FILM_SIZE).contains(&value) {
             return Err(SceneError::new(

@@ -24,7 +24,7 @@ pub use checkerboard::Checkerboard;
 pub use compose::Child;
 pub use constant::Constant;
 pub use layered::Layered;
-pub use load::{LoadError, Texels, load, load_image};
+pub use load::{LoadError, Texels, load, load_bytes, load_image};
 pub use srgb::{linear_to_srgb, srgb_to_linear};
 pub use uv_transform::UvTransform;
 pub use wrap::WrapMode;

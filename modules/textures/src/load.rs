@@ -64,6 +64,22 @@ pub fn load(path: &Path, raw: bool) -> Result<Texels, LoadError> {
     } else {
         load_image(path, raw)?
     };
+    usable(texels, path)
+}
+
+/// Decodes a PNG or JPEG image held in memory (an image embedded in a
+/// glTF file, say) as [`load`] reads a file; `origin` names it in errors.
+pub fn load_bytes(bytes: &[u8], origin: &Path, raw: bool) -> Result<Texels, LoadError> {
+    let reader = || {
+        image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| read_error(origin, e))
+    };
+    usable(decode(origin, raw, reader)?, origin)
+}
+
+/// `texels` if they hold pixels and all of them are finite.
+fn usable(texels: Texels, path: &Path) -> Result<Texels, LoadError> {
     if texels.width == 0 || texels.height == 0 {
         return Err(LoadError::Empty(path.to_path_buf()));
     }
@@ -111,6 +127,17 @@ pub fn load_image(path: &Path, raw: bool) -> Result<Texels, LoadError> {
             .with_guessed_format()
             .map_err(|e| read_error(path, e))
     };
+    decode(path, raw, reader)
+}
+
+/// Decodes the image that `reader` opens (twice: once for its size, which
+/// is checked against the memory left, then for its pixels); `path` names
+/// it in errors.
+fn decode<R: std::io::BufRead + std::io::Seek>(
+    path: &Path,
+    raw: bool,
+    reader: impl Fn() -> Result<image::ImageReader<R>, LoadError>,
+) -> Result<Texels, LoadError> {
     let (width, height) = reader()?
         .into_dimensions()
         .map_err(|e| read_error(path, e))?;
@@ -124,7 +151,7 @@ pub fn load_image(path: &Path, raw: bool) -> Result<Texels, LoadError> {
         image::ColorType::Rgb32F | image::ColorType::Rgba32F
     );
     let rgb = decoded.to_rgb32f();
-    let decode = |c: f32| {
+    let to_linear = |c: f32| {
         if is_float || raw {
             c
         } else {
@@ -136,7 +163,7 @@ pub fn load_image(path: &Path, raw: bool) -> Result<Texels, LoadError> {
         height: rgb.height(),
         data: rgb
             .pixels()
-            .map(|p| Rgb::new(decode(p[0]), decode(p[1]), decode(p[2])))
+            .map(|p| Rgb::new(to_linear(p[0]), to_linear(p[1]), to_linear(p[2])))
             .collect(),
     })
 }

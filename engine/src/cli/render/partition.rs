@@ -35,6 +35,7 @@ pub(super) fn run(
     }
     check_output(&frame_path(&args.output, 0))?;
     let mut scene = radiant::scene::load(&args.scene).map_err(report)?;
+    super::passes::check(args, &scene.settings)?;
     let scene_bytes = std::fs::read(&args.scene)
         .map_err(|e| miette::miette!("cannot read the scene `{}`: {e}", args.scene.display()))?;
     let timeline = scene.timeline;

@@ -8,10 +8,11 @@ use super::RenderArgs;
 use clap::Args;
 use radiant::backend::{BackendKind, Progress, Written, cpu};
 use radiant::extract::{Overrides, RenderScene};
-use radiant::film::aov::{self, Aov};
+use radiant::film::aov::{self, AovSet};
 use radiant::film::denoise::{Denoiser, Guides};
 use radiant::film::{layers, output};
 use radiant::settings::FilterSampling;
+use radiant::settings::RenderSettings;
 use std::path::Path;
 use std::time::Instant;
 
@@ -21,62 +22,65 @@ pub struct PassArgs {
     /// Output variables to write as layers of the EXR, comma-separated:
     /// albedo, normal, depth, position, spp (channels `albedo.R/G/B`,
     /// `normal.X/Y/Z`, `depth.Z`, `position.X/Y/Z`, `spp.Y`; the beauty's
-    /// alpha goes to `A`). Renders on the CPU.
+    /// alpha goes to `A`). Replaces the scene's `film: {aovs: […]}`
+    /// (`--aov ""` writes none). Renders on the CPU.
     #[arg(long, value_parser = parse_aovs)]
-    pub aov: Option<AovList>,
+    pub aov: Option<AovSet>,
     /// Denoise the image with Intel Open Image Denoise, guided by the
     /// first hits' albedo and normals (see the README, "Denoising").
     #[arg(long)]
     pub denoise: bool,
 }
 
-/// A parsed `--aov` list.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct AovList(pub Vec<Aov>);
-
-fn parse_aovs(text: &str) -> Result<AovList, String> {
+fn parse_aovs(text: &str) -> Result<AovSet, String> {
     aov::parse_list(text)
-        .map(AovList)
+        .map(|list| list.into_iter().collect())
         .map_err(|e| e.to_string())
 }
 
 impl PassArgs {
-    /// The output variables `--aov` asks for.
-    fn aovs(&self) -> &[Aov] {
-        self.aov.as_ref().map_or(&[], |l| &l.0)
+    /// The output variables to write: `--aov`'s, else the scene's.
+    fn aovs(&self, settings: &RenderSettings) -> AovSet {
+        self.aov.unwrap_or(settings.output.aovs)
     }
 
-    /// `overrides` as the passes need them: `--denoise` samples the pixel
+    /// `overrides` as the passes need them: `--aov` replaces the scene's
+    /// output variables, and `--denoise` samples the pixel
     /// filter by importance (`film: {filter_sampling: importance}`), since
     /// OIDN expects independent noise in each pixel and splatting
     /// correlates neighbours, which it keeps as detail (16-spp Cornell box:
     /// relMSE 8.5e-4 denoised against 4.6e-3 splatted; `tests/denoise.rs`).
-    pub(super) fn overrides(&self, overrides: Overrides) -> Overrides {
-        if self.denoise {
-            Overrides {
-                filter_sampling: Some(FilterSampling::Importance),
-                ..overrides
-            }
-        } else {
-            overrides
+    pub(super) fn overrides(&self, mut overrides: Overrides) -> Overrides {
+        if self.aov.is_some() {
+            overrides.output.aovs = self.aov;
         }
+        if self.denoise {
+            overrides.filter_sampling = Some(FilterSampling::Importance);
+        }
+        overrides
     }
 
-    /// Whether frames render through [`write`].
-    pub(super) fn wanted(&self) -> bool {
-        self.denoise || !self.aovs().is_empty()
+    /// Whether frames of a scene with `settings` render through [`write`].
+    pub(super) fn wanted(&self, settings: &RenderSettings) -> bool {
+        self.denoise || !self.aovs(settings).is_empty()
     }
 }
 
-/// Checks, before anything renders, that the passes can be made as asked:
-/// by the CPU backend, into an EXR where there are layers, not into a
-/// partition.
-pub(super) fn check(args: &RenderArgs) -> miette::Result<()> {
+/// Checks, before anything renders, that the passes can be made as asked
+/// for a scene with `settings` (before the flags are applied): by the CPU
+/// backend, into an EXR where there are layers, not into a partition.
+pub(super) fn check(args: &RenderArgs, settings: &RenderSettings) -> miette::Result<()> {
     let passes = &args.passes;
-    if !passes.wanted() {
+    if !passes.wanted(settings) {
         return Ok(());
     }
-    let what = if passes.denoise { "--denoise" } else { "--aov" };
+    let what = if passes.denoise {
+        "--denoise"
+    } else if passes.aov.is_some() {
+        "--aov"
+    } else {
+        "the scene's `film: {aovs: […]}` (`--aov \"\"` leaves them out)"
+    };
     if args.backend == BackendKind::Gpu {
         miette::bail!(
             "{what} needs the CPU backend: the GPU kernel does not record first hits yet; \
@@ -95,9 +99,9 @@ pub(super) fn check(args: &RenderArgs) -> miette::Result<()> {
              render the passes with a whole render"
         );
     }
-    if !passes.aovs().is_empty() && !is_exr(&args.output) {
+    if !passes.aovs(settings).is_empty() && !is_exr(&args.output) {
         miette::bail!(
-            "--aov writes layers of an EXR file, and `{}` is not one: name the output .exr",
+            "{what} writes layers of an EXR file, and `{}` is not one: name the output .exr",
             args.output.display()
         );
     }
@@ -118,7 +122,7 @@ pub(super) fn write(
     progress: &Progress<'_>,
     note: &dyn Fn(&str),
 ) -> miette::Result<Written> {
-    let aovs = args.aovs();
+    let aovs = scene.settings.output.aovs.list();
     // Loaded before rendering, so that a missing library costs no render.
     let denoiser = args
         .denoise
@@ -148,7 +152,7 @@ pub(super) fn write(
     } else if aovs.is_empty() {
         output::write_encoded(path, &image, &scene.settings.output)
     } else {
-        layers::write(path, &image, &planes, aovs)
+        layers::write(path, &image, &planes, &aovs)
     }
     .map_err(|e| miette::miette!("{e}"))?;
     Ok(written)

@@ -7,6 +7,7 @@
 use crate::world::MeshData;
 use glam::{DMat4, Vec2, Vec3};
 use gltf::mesh::Mode;
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
 /// A glTF file read with its buffers.
@@ -83,6 +84,61 @@ impl Asset {
         Ok(out)
     }
 
+    /// The encoded bytes of image `index`: its `data:` URI decoded, its
+    /// buffer view's bytes, or the file it names beside the glTF file.
+    pub(super) fn image_bytes(&self, index: usize) -> Result<Cow<'_, [u8]>, String> {
+        let name = self.path.display();
+        let image = self.document.images().nth(index).ok_or_else(|| {
+            format!(
+                "glTF file `{name}` has {} images; there is no image {index}",
+                self.document.images().len()
+            )
+        })?;
+        match image.source() {
+            gltf::image::Source::View { view, .. } => {
+                let bytes = self.view(&view)?;
+                Ok(Cow::Borrowed(bytes))
+            }
+            gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => {
+                let base = self.path.parent().unwrap_or(Path::new("."));
+                gltf::buffer::Data::from_source(gltf::buffer::Source::Uri(uri), Some(base))
+                    .map(|d| Cow::Owned(d.0))
+                    .map_err(|e| format!("glTF file `{name}`: image {index}'s data URI: {e}"))
+            }
+            gltf::image::Source::Uri { uri, .. } => {
+                let file = self.path.parent().unwrap_or(Path::new(".")).join(uri);
+                radiant_core::input_file::reject_special_file(&file)
+                    .and_then(|()| std::fs::read(&file).map_err(|e| e.to_string()))
+                    .map(Cow::Owned)
+                    .map_err(|e| {
+                        format!(
+                            "glTF file `{name}`: image {index} is the file `{uri}`, which cannot \
+                             be read (looked for `{}`): {e}",
+                            file.display()
+                        )
+                    })
+            }
+        }
+    }
+
+    /// The bytes of buffer view `view`, checked to lie within its buffer.
+    fn view(&self, view: &gltf::buffer::View<'_>) -> Result<&[u8], String> {
+        let data = self
+            .buffers
+            .get(view.buffer().index())
+            .map_or(&[][..], |d| &d.0[..]);
+        let end = view.offset().saturating_add(view.length());
+        data.get(view.offset()..end).ok_or_else(|| {
+            format!(
+                "glTF file `{}`: buffer view {} ends at byte {end}, but buffer {} holds {} bytes",
+                self.path.display(),
+                view.index(),
+                view.buffer().index(),
+                data.len()
+            )
+        })
+    }
+
     /// Checks that `accessor` lies within its buffer view and the view
     /// within its buffer, so that reading it cannot run past the data.
     pub(super) fn check(&self, accessor: &gltf::Accessor<'_>) -> Result<(), String> {
@@ -99,18 +155,7 @@ impl Asset {
                 accessor.index()
             ));
         };
-        let held = self
-            .buffers
-            .get(view.buffer().index())
-            .map_or(0, |d| d.len());
-        let view_end = view.offset().saturating_add(view.length());
-        if view_end > held {
-            return Err(format!(
-                "glTF file `{name}`: buffer view {} ends at byte {view_end}, but buffer {} holds {held} bytes",
-                view.index(),
-                view.buffer().index()
-            ));
-        }
+        self.view(&view)?;
         let size = accessor.size();
         let stride = view.stride().unwrap_or(size);
         let needed = match accessor.count() {
@@ -131,12 +176,14 @@ impl Asset {
         Ok(())
     }
 
-    /// The mesh of one primitive, repaired, with its tangents; flat where
-    /// it has no normals or `face_normals`.
+    /// The mesh of one primitive, repaired, with its tangents and the
+    /// texture coordinates of set `tex_coord`; flat where it has no
+    /// normals or `face_normals`.
     pub(super) fn primitive(
         &self,
         mesh: &gltf::Mesh<'_>,
         primitive: &gltf::Primitive<'_>,
+        tex_coord: u32,
         face_normals: bool,
     ) -> Result<MeshData, String> {
         let what = format!(
@@ -149,8 +196,9 @@ impl Asset {
         for (semantic, accessor) in primitive.attributes() {
             if matches!(
                 semantic,
-                gltf::Semantic::Positions | gltf::Semantic::Normals | gltf::Semantic::TexCoords(0)
-            ) {
+                gltf::Semantic::Positions | gltf::Semantic::Normals
+            ) || semantic == gltf::Semantic::TexCoords(tex_coord)
+            {
                 self.check(&accessor)?;
             }
         }
@@ -199,7 +247,7 @@ impl Asset {
             source: format!("{}#mesh{}", self.path.display(), mesh.index()),
             normals: reader.read_normals().map(|n| n.map(Vec3::from).collect()),
             uvs: reader
-                .read_tex_coords(0)
+                .read_tex_coords(tex_coord)
                 .map(|t| t.into_f32().map(Vec2::from).collect()),
             positions,
             triangles,

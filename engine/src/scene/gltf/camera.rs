@@ -1,4 +1,5 @@
-//! A glTF camera as the YAML of a Radiant `perspective` camera.
+//! A glTF camera as the YAML of a Radiant `perspective` or `orthographic`
+//! camera.
 
 use super::asset::Asset;
 use super::{generated, list};
@@ -8,9 +9,11 @@ use marked_yaml::Node;
 use std::path::Path;
 
 /// The camera mapping that a `camera: {type: gltf, filename: …}` stands
-/// for: the first perspective camera among the default scene's nodes, as
-/// a `perspective` camera placed by its node (glTF cameras look down −z
-/// with +x to the right; Radiant's look down +z with +x to the left).
+/// for: the first camera among the default scene's nodes, as a
+/// `perspective` camera with its vertical field of view or an
+/// `orthographic` one `2 · xmag` wide, placed by its node (glTF cameras
+/// look down −z with +x to the right; Radiant's look down +z with +x to
+/// the left). Clipping planes are not carried over.
 pub(in crate::scene) fn camera_yaml(
     file: &Path,
     dir: &Path,
@@ -38,19 +41,19 @@ pub(in crate::scene) fn camera_yaml(
                 asset.path.display()
             ))
         })?;
-    let gltf::camera::Projection::Perspective(p) = camera.projection() else {
-        return Err(located(format!(
-            "glTF file `{}`: camera {} is orthographic; Radiant imports perspective glTF cameras",
-            asset.path.display(),
-            camera.index()
-        )));
-    };
     let flip = DMat4::from_scale(DVec3::new(-1.0, 1.0, -1.0));
-    let text = format!(
-        "{{type: perspective, fov: {:?}, fov_axis: y, transform: {}}}",
-        f64::from(p.yfov()).to_degrees(),
-        matrix_yaml(to_world * flip)
-    );
+    let pose = matrix_yaml(to_world * flip);
+    let text = match camera.projection() {
+        gltf::camera::Projection::Perspective(p) => format!(
+            "{{type: perspective, fov: {:?}, fov_axis: y, transform: {pose}}}",
+            f64::from(p.yfov()).to_degrees()
+        ),
+        // xmag is half the view's width; the height follows the film.
+        gltf::camera::Projection::Orthographic(o) => format!(
+            "{{type: orthographic, width: {:?}, transform: {pose}}}",
+            2.0 * f64::from(o.xmag())
+        ),
+    };
     generated(&asset.path, &text)
 }
 
