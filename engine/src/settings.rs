@@ -88,6 +88,11 @@ pub enum LightSelection {
     Power,
     /// Every light equally likely.
     Uniform,
+    /// By each light's importance at the shading point — its power over
+    /// the squared distance, zero outside its emission cone (pbrt-v4's
+    /// light bounds, after Conty and Kulla 2018); lights at infinity take
+    /// a fixed share.
+    Spatial,
 }
 
 /// BVH build quality preset.
@@ -220,6 +225,7 @@ impl fmt::Display for LightSelection {
         f.write_str(match self {
             LightSelection::Power => "power",
             LightSelection::Uniform => "uniform",
+            LightSelection::Spatial => "spatial",
         })
     }
 }

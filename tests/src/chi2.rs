@@ -165,6 +165,19 @@ impl Chi2 {
         self.test(&observed, &expected, succeeded, drawn)
     }
 
+    /// Runs the test on the counts `observed` of a discrete choice among
+    /// `observed.len()` outcomes against their expected counts out of
+    /// `drawn` draws (a draw counted in no outcome failed).
+    pub fn run_discrete(
+        &self,
+        observed: &[f64],
+        expected: &[f64],
+        drawn: usize,
+    ) -> Result<f64, String> {
+        let succeeded = observed.iter().sum::<f64>() as usize;
+        self.test(observed, expected, succeeded, drawn)
+    }
+
     /// The normalisation check and the pooled chi-square test shared by
     /// [`run`](Self::run) and [`run_planar`](Self::run_planar).
     fn test(

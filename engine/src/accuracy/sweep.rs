@@ -36,7 +36,7 @@ pub enum Axis {
     FilterSampling,
     /// Every registered sampler, with its default parameters.
     Sampler,
-    /// Light selection of next-event estimation (power, uniform).
+    /// Light selection of next-event estimation (power, uniform, spatial).
     LightSelection,
     /// BVH build quality (fast, medium, high): build time against trace time.
     Bvh,
@@ -146,6 +146,7 @@ impl Setting {
             Change::FilterSampling(FilterSampling::Importance) => "importance".into(),
             Change::LightSelection(LightSelection::Power) => "power".into(),
             Change::LightSelection(LightSelection::Uniform) => "uniform".into(),
+            Change::LightSelection(LightSelection::Spatial) => "spatial".into(),
             Change::Bvh(q) => format!("{q:?}").to_lowercase(),
             Change::Gpu => "gpu".into(),
             Change::Denoise => "on".into(),
@@ -232,15 +233,19 @@ pub fn settings(scene: &Scene, registry: &Registry, axes: &[Axis]) -> (Vec<Setti
                     + scene.world.query::<&EmitterSpec>().iter().count();
                 if lights < 2 {
                     notes.push(format!(
-                        "light_selection: the scene has {lights} light, so power and uniform selection are the same"
+                        "light_selection: the scene has {lights} light, so power, uniform and spatial selection are the same"
                     ));
                     continue;
                 }
-                [LightSelection::Power, LightSelection::Uniform]
-                    .into_iter()
-                    .filter(|l| *l != s.light_selection)
-                    .map(Change::LightSelection)
-                    .collect()
+                [
+                    LightSelection::Power,
+                    LightSelection::Uniform,
+                    LightSelection::Spatial,
+                ]
+                .into_iter()
+                .filter(|l| *l != s.light_selection)
+                .map(Change::LightSelection)
+                .collect()
             }
             Axis::Bvh => [BuildQuality::Fast, BuildQuality::Medium]
                 .into_iter()
@@ -467,7 +472,8 @@ mod tests {
                 "sampler=halton",
                 "sampler=sobol",
                 "sampler=stratified",
-                "light_selection=uniform"
+                "light_selection=uniform",
+                "light_selection=spatial"
             ]
         );
         assert!(notes.is_empty());

@@ -1,9 +1,27 @@
 //! The light table: every light of the frame and the distribution that
-//! chooses one per next-event estimate, proportional to power or uniform
-//! ([`LightSelection`]).
+//! chooses one per next-event estimate, proportional to power, uniform, or
+//! by each light's importance at the shading point ([`LightSelection`]).
+//!
+//! Spatial selection weighs the lights that report [`LightBounds`] by
+//! [`LightBounds::importance`] at the shading point and gives lights
+//! without bounds (environments, directional lights) together the fixed
+//! share n∞ / (n∞ + 1), as pbrt-v4's light sampler does. Up to
+//! [`FLAT_LIMIT`] bounded lights, every light's importance is evaluated
+//! (two passes: the total, then the walk to the chosen light), so the
+//! choice is exactly in proportion to it; beyond, the lights are chosen
+//! through a [`LightTree`] in O(log n). [`LightTable::select_at`] and
+//! [`LightTable::pmf_at`] compute the same sums in the same order, so the
+//! probability an emitter hit is weighted with is bit for bit the one its
+//! sample was drawn with.
 
+use super::light_tree::LightTree;
 use crate::settings::LightSelection;
-use radiant_core::{Effects, Light};
+use radiant_core::glam::Vec3;
+use radiant_core::{Effects, Light, LightBounds};
+
+/// Most bounded lights whose importance spatial selection evaluates one by
+/// one; more are chosen through a [`LightTree`].
+pub const FLAT_LIMIT: usize = 16;
 
 /// The scene's lights with their selection probabilities.
 #[derive(Default)]
@@ -13,6 +31,18 @@ pub struct LightTable {
     pmf: Vec<f32>,
     delta: Vec<bool>,
     environment: Vec<usize>,
+    selection: LightSelection,
+    /// Spatial selection: the lights with bounds, and theirs.
+    bounded: Vec<(u32, LightBounds)>,
+    /// Spatial selection: the lights without bounds.
+    unbounded: Vec<u32>,
+    /// Spatial selection: the share of the unbounded lights.
+    p_unbounded: f32,
+    /// Spatial selection: each light's place in `bounded` (`u32::MAX` if
+    /// it has no bounds).
+    slot_of: Vec<u32>,
+    /// Spatial selection among more than [`FLAT_LIMIT`] bounded lights.
+    tree: Option<LightTree>,
 }
 
 impl LightTable {
@@ -24,7 +54,9 @@ impl LightTable {
             .iter()
             .map(|l| {
                 let p = match selection {
-                    LightSelection::Power => l.power() as f64,
+                    // Spatial selection keeps power as its table for
+                    // `select` (the GPU backend's choice).
+                    LightSelection::Power | LightSelection::Spatial => l.power() as f64,
                     LightSelection::Uniform => 1.0,
                 };
                 if p.is_finite() && p > 0.0 { p } else { 0.0 }
@@ -51,13 +83,135 @@ impl LightTable {
         let environment = (0..lights.len())
             .filter(|&i| lights[i].effects().contains(Effects::ENVIRONMENT))
             .collect();
+        let (mut bounded, mut unbounded) = (Vec::new(), Vec::new());
+        for (i, light) in lights.iter().enumerate() {
+            match light.bounds() {
+                Some(b) if b.phi > 0.0 && b.phi.is_finite() => bounded.push((i as u32, b)),
+                // A light with bounds but no power never gets a sample.
+                Some(_) => {}
+                None => unbounded.push(i as u32),
+            }
+        }
+        let mut slot_of = vec![u32::MAX; lights.len()];
+        for (slot, (i, _)) in bounded.iter().enumerate() {
+            slot_of[*i as usize] = slot as u32;
+        }
+        let tree = (bounded.len() > FLAT_LIMIT).then(|| {
+            let b: Vec<LightBounds> = bounded.iter().map(|(_, b)| *b).collect();
+            LightTree::new(&b)
+        });
+        let p_unbounded = match (unbounded.len(), bounded.is_empty()) {
+            (0, _) => 0.0,
+            (_, true) => 1.0,
+            (n, false) => n as f32 / (n + 1) as f32,
+        };
         Self {
             lights,
             cdf,
             pmf,
             delta,
             environment,
+            selection,
+            bounded,
+            unbounded,
+            p_unbounded,
+            slot_of,
+            tree,
         }
+    }
+
+    /// Whether the choice depends on the shading point
+    /// ([`LightSelection::Spatial`] with more than one light).
+    #[inline]
+    pub fn is_spatial(&self) -> bool {
+        self.selection == LightSelection::Spatial && self.lights.len() > 1
+    }
+
+    /// Chooses a light for the shading point `p` with the uniform sample
+    /// `u`; returns its index and probability (0 where no light can reach
+    /// `p`: the sample then carries nothing). Without spatial selection,
+    /// [`select`](Self::select).
+    #[inline]
+    pub fn select_at(&self, p: Vec3, u: f32) -> (usize, f32) {
+        if !self.is_spatial() {
+            let (i, pmf, _) = self.select(u);
+            return (i, pmf);
+        }
+        if u < self.p_unbounded {
+            let n = self.unbounded.len();
+            let k = ((u / self.p_unbounded * n as f32) as usize).min(n - 1);
+            return (self.unbounded[k] as usize, self.p_unbounded / n as f32);
+        }
+        let Some(&(first, _)) = self.bounded.first() else {
+            return (0, 0.0);
+        };
+        let share = 1.0 - self.p_unbounded;
+        if let Some(tree) = &self.tree {
+            let v = ((u - self.p_unbounded) / share).clamp(0.0, 0.999_999_94);
+            return match tree.select(p, v) {
+                Some((slot, pmf)) => (self.bounded[slot].0 as usize, share * pmf),
+                None => (first as usize, 0.0),
+            };
+        }
+        let total = self.total_importance(p);
+        if total <= 0.0 {
+            return (first as usize, 0.0);
+        }
+        let target = (u - self.p_unbounded) / share * total;
+        let mut acc = 0.0f32;
+        let mut last = (first as usize, 0.0f32);
+        for (i, b) in &self.bounded {
+            let w = b.importance(p);
+            if w <= 0.0 {
+                continue;
+            }
+            acc += w;
+            last = (*i as usize, w);
+            if target < acc {
+                break;
+            }
+        }
+        (last.0, share * last.1 / total)
+    }
+
+    /// Probability that [`select_at`](Self::select_at) picks light `i` for
+    /// the shading point `p` (the point an emitter-hit ray left from).
+    #[inline]
+    pub fn pmf_at(&self, p: Vec3, i: usize) -> f32 {
+        if !self.is_spatial() {
+            return self.pmf[i];
+        }
+        let slot = self.slot_of[i] as usize;
+        if let Some((_, b)) = self.bounded.get(slot) {
+            let share = 1.0 - self.p_unbounded;
+            if let Some(tree) = &self.tree {
+                return share * tree.pmf(p, slot);
+            }
+            let total = self.total_importance(p);
+            return if total > 0.0 {
+                share * b.importance(p) / total
+            } else {
+                0.0
+            };
+        }
+        if self.unbounded.contains(&(i as u32)) {
+            self.p_unbounded / self.unbounded.len() as f32
+        } else {
+            0.0
+        }
+    }
+
+    /// Σ importance at `p` over the bounded lights, in their order.
+    #[inline]
+    fn total_importance(&self, p: Vec3) -> f32 {
+        let mut total = 0.0f32;
+        for (_, b) in &self.bounded {
+            let w = b.importance(p);
+            if w > 0.0 {
+                total += w;
+            }
+        }
+        total
     }
 
     /// Puts each `(i, light)` of `replacements` in place of light `i`,

@@ -24,6 +24,7 @@
 
 pub mod facing;
 mod geometry;
+mod light_tree;
 mod lights;
 mod materials;
 mod media;
@@ -31,7 +32,7 @@ mod modules;
 mod sequence;
 mod shapes;
 
-pub use lights::LightTable;
+pub use lights::{FLAT_LIMIT, LightTable};
 pub use media::MediaTable;
 pub use sequence::{FrameUpdate, Sequence, SequenceOptions};
 pub(crate) use shapes::BARYCENTRIC_UVS;

@@ -585,10 +585,10 @@ impl Wavefront {
             }
         }
         for light in 0..nlights {
-            let pmf = scene.lights.pmf(light);
             for k in self.offsets[light] as usize..self.offsets[light + 1] as usize {
                 let i = self.em_slots[k] as usize;
                 let e = self.em_evals[k];
+                let pmf = scene.lights.pmf_at(self.em_hits[k].origin, light);
                 let w = bsdf_hit_weight(depth, self.prev_pdf[i], pmf * e.pdf);
                 self.radiance[i] += self.beta[i] * e.radiance * w;
             }
@@ -609,9 +609,9 @@ impl Wavefront {
         }
         for &light in scene.lights.environment() {
             scene.lights.lights()[light].eval_escaped(&self.esc_dirs, &mut self.esc_evals);
-            let pmf = scene.lights.pmf(light);
             for (&slot, e) in self.esc_slots.iter().zip(&self.esc_evals) {
                 let i = slot as usize;
+                let pmf = scene.lights.pmf_at(self.origin[i], light);
                 let w = bsdf_hit_weight(depth, self.prev_pdf[i], pmf * e.pdf);
                 self.radiance[i] += self.beta[i] * e.radiance * w;
             }
@@ -740,7 +740,8 @@ impl Wavefront {
         fit(&mut self.u1, n);
         scene.sampler.fill_1d(&self.ids_k, base, &mut self.u1);
         for k in 0..n {
-            let (l, p, _) = scene.lights.select(self.u1[k]);
+            let at = self.its[self.live[k] as usize].p;
+            let (l, p) = scene.lights.select_at(at, self.u1[k]);
             self.light[k] = l as u32;
             self.light_prob[k] = p;
         }

@@ -186,9 +186,9 @@ pub const SCENE_KEYS: &[KeyDocs] = &[
             ),
             key(
                 "light_selection",
-                "power | uniform",
+                "power | uniform | spatial",
                 "power",
-                "How next-event estimation picks a light.",
+                "How next-event estimation picks a light: by power, uniformly, or by importance at the shading point.",
             ),
         ],
     },

@@ -1,0 +1,204 @@
+//! Spatial bounds of a light's emission, for light selection that knows
+//! where the shading point is.
+//!
+//! A light that has a place in the scene reports [`LightBounds`] through
+//! [`Light::bounds`](crate::Light::bounds): the box that holds it, its
+//! power, and the cone of directions in which it emits (pbrt-v4's
+//! `LightBounds`, after Conty and Kulla 2018). The engine's spatial light
+//! selection weighs every light by [`LightBounds::importance`] at the
+//! shading point — a conservative estimate of the irradiance the light can
+//! deliver there — instead of by power alone. Importance is 0 only where
+//! the light cannot send any light to the point, so selection by it stays
+//! unbiased.
+
+use glam::Vec3;
+
+/// Where a light is and in which directions it emits.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightBounds {
+    /// Smallest corner of the box holding the light (render space).
+    pub min: Vec3,
+    /// Largest corner of that box.
+    pub max: Vec3,
+    /// Emitted power as seen by selection: radiance × area for surfaces,
+    /// intensity for point-like lights (so that φ / d² estimates irradiance).
+    pub phi: f32,
+    /// Unit axis of the cone that holds the surface normals (or the
+    /// emission direction of a spot light).
+    pub axis: Vec3,
+    /// Cosine of the half angle of that cone (−1: every direction).
+    pub cos_theta_o: f32,
+    /// Cosine of the angle beyond the normals' cone in which light still
+    /// leaves (0 for surfaces emitting over their hemisphere).
+    pub cos_theta_e: f32,
+    /// Whether the surfaces emit from both sides.
+    pub two_sided: bool,
+}
+
+/// cos(max(0, a − b)) from the sines and cosines of a and b.
+#[inline]
+fn cos_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
+    if cos_a > cos_b {
+        1.0
+    } else {
+        cos_a * cos_b + sin_a * sin_b
+    }
+}
+
+/// sin(max(0, a − b)) from the sines and cosines of a and b.
+#[inline]
+fn sin_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
+    if cos_a > cos_b {
+        0.0
+    } else {
+        sin_a * cos_b - cos_a * sin_b
+    }
+}
+
+#[inline]
+fn sin_from_cos(c: f32) -> f32 {
+    (1.0 - c * c).max(0.0).sqrt()
+}
+
+impl LightBounds {
+    /// Bounds of a point-like light at `p` emitting into the cone of half
+    /// angle θo about `axis` (−1 for every direction), with a fall-off
+    /// reaching θe further.
+    pub fn point(p: Vec3, phi: f32, axis: Vec3, cos_theta_o: f32, cos_theta_e: f32) -> Self {
+        Self {
+            min: p,
+            max: p,
+            phi,
+            axis,
+            cos_theta_o,
+            cos_theta_e,
+            two_sided: false,
+        }
+    }
+
+    /// The importance of the light for a shading point `p`: φ · cos θ' / d²,
+    /// where d is the distance to the box's centre (at least half its
+    /// diagonal) and θ' the smallest angle between the emission cone and
+    /// the direction to `p` that the box allows. 0 where the light cannot
+    /// reach `p`.
+    #[inline]
+    pub fn importance(&self, p: Vec3) -> f32 {
+        let centre = (self.min + self.max) * 0.5;
+        let diagonal = self.max - self.min;
+        let to_p = p - centre;
+        let d2 = to_p.length_squared().max(diagonal.length() * 0.5);
+        if d2 <= 0.0 {
+            // A point light at p sends nothing there.
+            return 0.0;
+        }
+        if self.cos_theta_o <= -1.0 && self.min == self.max {
+            // An isotropic point: no angular bound to apply.
+            return self.phi / d2;
+        }
+        // The angle the box subtends from p (all directions from inside).
+        let radius2 = diagonal.length_squared() * 0.25;
+        let dist2 = to_p.length_squared();
+        let inside = p.cmpge(self.min).all() && p.cmple(self.max).all();
+        let (sin_b, cos_b) = if inside || dist2 <= radius2 {
+            (0.0, -1.0)
+        } else {
+            let sin2 = radius2 / dist2;
+            (sin2.sqrt(), (1.0 - sin2).max(0.0).sqrt())
+        };
+        let len = dist2.sqrt();
+        let mut cos_w = if len > 0.0 {
+            to_p.dot(self.axis) / len
+        } else {
+            1.0
+        };
+        if self.two_sided {
+            cos_w = cos_w.abs();
+        }
+        let sin_w = sin_from_cos(cos_w);
+        let sin_o = sin_from_cos(self.cos_theta_o);
+        // θw − θo, then minus θb.
+        let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, self.cos_theta_o);
+        let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, self.cos_theta_o);
+        let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
+        if cos_p <= self.cos_theta_e {
+            return 0.0;
+        }
+        (self.phi * cos_p / d2).max(0.0)
+    }
+
+    /// Bounds of surfaces with the given box, the summed area-weighted
+    /// normal `normal_sum`, the unit normals `normals` (to find the cone)
+    /// and power `phi`, emitting over the front hemisphere.
+    pub fn surface(
+        min: Vec3,
+        max: Vec3,
+        phi: f32,
+        normal_sum: Vec3,
+        normals: impl Iterator<Item = Vec3>,
+    ) -> Self {
+        let axis = normal_sum.normalize_or_zero();
+        let cos_theta_o = if axis == Vec3::ZERO {
+            -1.0
+        } else {
+            normals.fold(1.0f32, |c, n| c.min(axis.dot(n)))
+        };
+        // Rounding must not narrow the cone: widen it a little.
+        let cos_theta_o = if cos_theta_o >= 1.0 - 1e-6 {
+            1.0 - 1e-6
+        } else {
+            (cos_theta_o - 1e-4).max(-1.0)
+        };
+        Self {
+            min,
+            max,
+            phi,
+            axis: if axis == Vec3::ZERO { Vec3::Z } else { axis },
+            cos_theta_o,
+            cos_theta_e: 0.0,
+            two_sided: false,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_point_falls_off_with_distance_squared() {
+        let b = LightBounds::point(Vec3::ZERO, 2.0, Vec3::Z, -1.0, 0.0);
+        assert!((b.importance(Vec3::new(0.0, 0.0, 2.0)) - 0.5).abs() < 1e-6);
+        assert!((b.importance(Vec3::new(0.0, -4.0, 0.0)) - 0.125).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_spot_is_dark_outside_its_cone() {
+        let (o, e) = (30f32.to_radians().cos(), 10f32.to_radians().cos());
+        let b = LightBounds::point(Vec3::ZERO, 1.0, Vec3::Z, o, e);
+        assert!(b.importance(Vec3::new(0.0, 0.0, 1.0)) > 0.99);
+        // 35° off axis: inside θo + θe = 40°.
+        let a = 35f32.to_radians();
+        assert!(b.importance(Vec3::new(a.sin(), 0.0, a.cos())) > 0.0);
+        // 45° off axis: outside.
+        let a = 45f32.to_radians();
+        assert_eq!(b.importance(Vec3::new(a.sin(), 0.0, a.cos())), 0.0);
+        assert_eq!(b.importance(Vec3::new(0.0, 0.0, -1.0)), 0.0);
+    }
+
+    #[test]
+    fn a_one_sided_rectangle_is_dark_behind_and_bright_in_front() {
+        let b = LightBounds::surface(
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            4.0,
+            Vec3::Z * 4.0,
+            [Vec3::Z, Vec3::Z].into_iter(),
+        );
+        assert!(b.importance(Vec3::new(0.0, 0.0, 3.0)) > 0.0);
+        assert!(b.importance(Vec3::new(5.0, 0.0, 0.01)) > 0.0);
+        assert_eq!(b.importance(Vec3::new(0.0, 0.0, -3.0)), 0.0);
+        assert_eq!(b.importance(Vec3::new(2.0, 0.0, -2.0)), 0.0);
+        // Never more than φ / (half diagonal) anywhere.
+        assert!(b.importance(Vec3::new(0.0, 0.0, 1e-3)) <= 4.0 / 2f32.sqrt() + 1e-5);
+    }
+}
