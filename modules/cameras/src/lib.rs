@@ -7,6 +7,7 @@
 //! module only parses its projection parameters. What the projections share
 //! (field of view, film to image plane) lives in `projection`.
 
+mod importance;
 mod orthographic;
 mod perspective;
 mod projection;

@@ -1,10 +1,11 @@
 //! The `perspective` camera: an ideal pinhole.
 
+use crate::importance::Lens;
 use crate::projection::{
     FOV_AXIS_DOC, FOV_DOC, FovAxis, InvalidParam, Pinhole, central_rays, default_fov, gpu_pose,
 };
 use radiant_core::glam::{Mat4, Vec2};
-use radiant_core::{Camera, CameraRays, GpuModule, ParamDoc, Registry};
+use radiant_core::{Camera, CameraRays, GpuModule, Importance, ParamDoc, Registry};
 use serde::Deserialize;
 
 #[derive(Debug, Deserialize)]
@@ -24,6 +25,7 @@ const DOCS: &[ParamDoc] = &[FOV_DOC, FOV_AXIS_DOC];
 pub struct Perspective {
     to_render: Mat4,
     pinhole: Pinhole,
+    lens: Lens,
 }
 
 impl Perspective {
@@ -34,9 +36,11 @@ impl Perspective {
         fov_degrees: f32,
         axis: FovAxis,
     ) -> Result<Self, InvalidParam> {
+        let pinhole = Pinhole::new(resolution, fov_degrees, axis)?;
         Ok(Self {
             to_render,
-            pinhole: Pinhole::new(resolution, fov_degrees, axis)?,
+            pinhole,
+            lens: Lens::new(to_render, pinhole, 0.0, 1.0),
         })
     }
 }
@@ -46,6 +50,10 @@ impl Camera for Perspective {
         central_rays(&self.to_render, film, out, |p| {
             self.pinhole.plane_point(p).extend(1.0)
         });
+    }
+
+    fn importance(&self) -> Option<&dyn Importance> {
+        Some(&self.lens)
     }
 
     fn gpu(&self) -> Option<GpuModule> {

@@ -126,6 +126,26 @@ impl Pinhole {
             .f32(self.tan_half.y)
     }
 
+    /// The image plane's area at distance 1.
+    pub(crate) fn plane_area(&self) -> f32 {
+        4.0 * self.tan_half.x * self.tan_half.y
+    }
+
+    /// The raster position that looks through the camera-space point
+    /// (x, y) of the plane z = 1 ([`plane_point`](Self::plane_point)'s
+    /// inverse), if it lies on the film.
+    #[inline]
+    pub(crate) fn raster_of(&self, plane: Vec2) -> Option<Vec2> {
+        let ndc = Vec2::new(-plane.x / self.tan_half.x, plane.y / self.tan_half.y);
+        let raster = Vec2::new(
+            (ndc.x + 1.0) / self.raster.scale.x,
+            (1.0 - ndc.y) / self.raster.scale.y,
+        );
+        let size = 2.0 / self.raster.scale;
+        (raster.x >= 0.0 && raster.y >= 0.0 && raster.x < size.x && raster.y < size.y)
+            .then_some(raster)
+    }
+
     /// The camera-space point (x, y) on the plane z = 1 that raster
     /// position `p` looks through.
     #[inline]

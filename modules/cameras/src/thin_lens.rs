@@ -7,12 +7,13 @@
 //! the same film position reaches, so that plane is in focus (Mitsuba 3's
 //! `thinlens`).
 
+use crate::importance::Lens;
 use crate::projection::{
     FOV_AXIS_DOC, FOV_DOC, FovAxis, InvalidParam, Pinhole, check_min, default_fov, gpu_pose,
 };
 use radiant_core::glam::{Mat4, Vec2};
 use radiant_core::warp::square_to_disk_concentric;
-use radiant_core::{Camera, CameraRays, Effects, GpuModule, ParamDoc, Registry};
+use radiant_core::{Camera, CameraRays, Effects, GpuModule, Importance, ParamDoc, Registry};
 use serde::Deserialize;
 
 #[derive(Debug, Deserialize)]
@@ -50,6 +51,7 @@ pub struct ThinLens {
     pinhole: Pinhole,
     aperture_radius: f32,
     focus_distance: f32,
+    lens: Lens,
 }
 
 impl ThinLens {
@@ -63,17 +65,17 @@ impl ThinLens {
         aperture_radius: f32,
         focus_distance: f32,
     ) -> Result<Self, InvalidParam> {
+        let pinhole = Pinhole::new(resolution, fov_degrees, axis)?;
+        let aperture_radius =
+            check_min("aperture_radius", aperture_radius, 0.0, true, "scene units")?;
+        let focus_distance =
+            check_min("focus_distance", focus_distance, 0.0, false, "scene units")?;
         Ok(Self {
             to_render,
-            pinhole: Pinhole::new(resolution, fov_degrees, axis)?,
-            aperture_radius: check_min(
-                "aperture_radius",
-                aperture_radius,
-                0.0,
-                true,
-                "scene units",
-            )?,
-            focus_distance: check_min("focus_distance", focus_distance, 0.0, false, "scene units")?,
+            pinhole,
+            aperture_radius,
+            focus_distance,
+            lens: Lens::new(to_render, pinhole, aperture_radius, focus_distance),
         })
     }
 
@@ -100,6 +102,10 @@ impl Camera for ThinLens {
 
     fn effects(&self) -> Effects {
         Effects::DEPTH_OF_FIELD
+    }
+
+    fn importance(&self) -> Option<&dyn Importance> {
+        Some(&self.lens)
     }
 
     fn gpu(&self) -> Option<GpuModule> {

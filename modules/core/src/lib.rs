@@ -34,7 +34,6 @@ pub mod gpu;
 pub mod hash;
 pub mod input_file;
 pub mod light;
-pub mod light_bounds;
 pub mod medium;
 pub mod memory;
 pub mod params;
@@ -46,14 +45,16 @@ pub mod texture;
 pub mod warp;
 
 pub use build::{BoundingSphere, BuildContext, EmitterShape, MaterialSource};
-pub use camera::{Camera, CameraRays};
+pub use camera::{Camera, CameraRayPdf, CameraRays, Importance, LensSample};
 pub use color::{Rgb, luminance};
 pub use effects::Effects;
 pub use filter::{Filter, FilterSampler};
 pub use frame::Frame;
 pub use gpu::{GpuLibrary, GpuModule, GpuParams};
-pub use light::{EmitterEval, EmitterHit, Light, LightSample};
-pub use light_bounds::LightBounds;
+pub use light::{
+    Emission, EmissionKind, EmissionPdf, EmissionSample, EmittedRay, EmitterEval, EmitterHit,
+    Light, LightSample,
+};
 pub use medium::{Coefficients, Medium, Phase};
 pub use params::{Color, Numbers, ParamError, Params, TextureInput};
 pub use registry::{ModuleInfo, ModuleKind, ParamDoc, Registry};

@@ -9,6 +9,10 @@
 //! are passed, per light whose effects contain [`Effects::ENVIRONMENT`], to
 //! [`Light::eval_escaped`].
 //!
+//! Bidirectional integrators also start paths *at* lights: a light that
+//! supports this answers [`Light::emission`] with its [`Emission`] side,
+//! which samples emitted rays and gives the densities of a given one.
+//!
 //! Lights infinitely far away (environment, directional) place their
 //! next-event sample points outside the scene's bounding sphere
 //! ([`BuildContext::scene_sphere`](crate::BuildContext::scene_sphere)):
@@ -87,12 +91,10 @@ pub trait Light: Send + Sync {
         out[..dirs.len()].fill(EmitterEval::default());
     }
 
-    /// Where the light is and where it emits, for selection that weighs
-    /// lights by their importance at the shading point
-    /// (`light_selection: spatial`). `None` (the default) for lights at
-    /// infinity and lights that do not say: spatial selection then gives
-    /// them a fixed share of the samples.
-    fn bounds(&self) -> Option<crate::LightBounds> {
+    /// The light's emission side, for light paths (bidirectional path
+    /// tracing); `None` where the type has none, and integrators that need
+    /// it refuse the scene, naming the light's type.
+    fn emission(&self) -> Option<&dyn Emission> {
         None
     }
 
@@ -103,4 +105,93 @@ pub trait Light: Send + Sync {
     }
     /// Effects this light needs.
     fn effects(&self) -> Effects;
+}
+
+/// Where an emitted ray's origin lies, which decides how its densities are
+/// measured.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum EmissionKind {
+    /// On a surface: `pdf_pos` per unit area, `pdf_dir` per unit solid
+    /// angle, the ray carries `radiance · |n · dir| / (pdf_pos · pdf_dir)`.
+    #[default]
+    Surface,
+    /// At one point (`point`, `spot`): the position is a delta
+    /// (`pdf_pos` 1), `radiance` is the intensity (W/sr).
+    Point,
+    /// From infinitely far away (`environment`): the ray starts on a disc
+    /// of the scene sphere's radius, perpendicular to `dir`, outside the
+    /// scene; `pdf_pos` is per unit area of that disc, `pdf_dir` per unit
+    /// solid angle, `n` is zero.
+    Infinite,
+    /// From infinitely far away along one direction (`directional`): the
+    /// direction is a delta (`pdf_dir` 1), `radiance` is the irradiance
+    /// (W/m²) and `pdf_pos` is per unit area of the disc.
+    Directional,
+}
+
+/// One emitted ray, as [`Emission::sample_emission`] draws it.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct EmissionSample {
+    /// The ray's origin, render space.
+    pub p: Vec3,
+    /// Unit surface normal at `p` on the emitting side (zero where there
+    /// is no surface).
+    pub n: Vec3,
+    /// Unit direction of travel.
+    pub dir: Vec3,
+    /// Radiance along `dir` (see [`EmissionKind`] for point-like and
+    /// directional lights), before division by the densities.
+    pub radiance: Rgb,
+    /// Density of `p` (see [`EmissionKind`]); 0 marks a failed sample.
+    pub pdf_pos: f32,
+    /// Density of `dir` given `p`, per unit solid angle (see
+    /// [`EmissionKind`]).
+    pub pdf_dir: f32,
+    /// How the densities are measured.
+    pub kind: EmissionKind,
+    /// Index of the primitive `p` lies on within the emitter's shape (as
+    /// in [`EmitterHit`]; 0 for lights without surfaces).
+    pub primitive: u32,
+}
+
+/// An emitted ray whose densities [`Emission::emission_pdf`] is asked
+/// for: a camera path that hit the light (`p` on its surface, `primitive`
+/// as in [`EmitterHit`]) or left the scene towards it (`p` unused).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct EmittedRay {
+    /// The point the ray leaves, render space.
+    pub p: Vec3,
+    /// Unit geometric normal at `p` (zero for lights at infinity).
+    pub n: Vec3,
+    /// Unit direction of travel (from the light towards the scene).
+    pub dir: Vec3,
+    /// Index of the primitive within the emitter's shape.
+    pub primitive: u32,
+}
+
+/// The densities of an [`EmittedRay`]: what [`Emission::sample_emission`]
+/// would give for it.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct EmissionPdf {
+    /// Density of the origin (as [`EmissionSample::pdf_pos`]).
+    pub pdf_pos: f32,
+    /// Density of the direction (as [`EmissionSample::pdf_dir`]).
+    pub pdf_dir: f32,
+}
+
+/// The emission side of a light: emitted rays for light paths.
+pub trait Emission: Send + Sync {
+    /// How this light's emitted rays are measured (the same for all).
+    fn kind(&self) -> EmissionKind;
+
+    /// Samples one emitted ray per pair of 2D samples (`u_pos[i]` for the
+    /// origin, `u_dir[i]` for the direction), writing every `out[i]`
+    /// (`pdf_pos` 0 for a failed sample).
+    fn sample_emission(&self, u_pos: &[Vec2], u_dir: &[Vec2], out: &mut [EmissionSample]);
+
+    /// The densities with which `sample_emission` draws each ray `rays[i]`
+    /// (0 where it never does), writing every `out[i]`. Delta
+    /// distributions count as 1 (a point light's `pdf_pos`, a directional
+    /// light's `pdf_dir`).
+    fn emission_pdf(&self, rays: &[EmittedRay], out: &mut [EmissionPdf]);
 }

@@ -15,7 +15,7 @@ use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::warp::{square_to_uniform_sphere, square_to_uniform_triangle};
 use radiant_core::{
     Color, Effects, EmitterEval, EmitterHit, EmitterShape, GpuModule, GpuParams, Light,
-    LightBounds, LightSample, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb, luminance,
+    LightSample, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb, luminance,
 };
 use serde::Deserialize;
 
@@ -67,8 +67,6 @@ pub struct AreaLight {
     /// Probability of picking each part (its share of the area).
     probability: Vec<f32>,
     area: f32,
-    /// Box, normal cone and power, for spatial light selection.
-    bounds: LightBounds,
 }
 
 impl AreaLight {
@@ -110,7 +108,6 @@ impl AreaLight {
             return Err("an area light needs a shape with a positive, finite surface area".into());
         }
         let probability = parts.iter().map(|p| (p.area() / total) as f32).collect();
-        let bounds = shape_bounds(&shape, luminance(radiance) * total as f32);
         Ok(Self {
             radiance,
             parts,
@@ -118,7 +115,6 @@ impl AreaLight {
             cdf,
             probability,
             area: total as f32,
-            bounds,
         })
     }
 
@@ -218,39 +214,9 @@ impl AreaLight {
     }
 }
 
-/// The box of `shape`, the cone of its normals (every direction where it
-/// has a sphere) and its power `phi`.
-fn shape_bounds(shape: &EmitterShape, phi: f32) -> LightBounds {
-    let (mut min, mut max) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    let mut normal_sum = Vec3::ZERO;
-    for [a, b, c] in &shape.triangles {
-        min = min.min(a.min(b.min(*c)));
-        max = max.max(a.max(b.max(*c)));
-        normal_sum += (*b - *a).cross(*c - *a);
-    }
-    for &(centre, r) in &shape.spheres {
-        min = min.min(centre - Vec3::splat(r));
-        max = max.max(centre + Vec3::splat(r));
-    }
-    let normals = shape
-        .triangles
-        .iter()
-        .map(|[a, b, c]| (*b - *a).cross(*c - *a).normalize_or_zero());
-    let sum = if shape.spheres.is_empty() {
-        normal_sum
-    } else {
-        Vec3::ZERO
-    };
-    LightBounds::surface(min, max, phi, sum, normals)
-}
-
 impl Light for AreaLight {
     fn power(&self) -> f32 {
         luminance(self.radiance) * self.area * std::f32::consts::PI
-    }
-
-    fn bounds(&self) -> Option<LightBounds> {
-        Some(self.bounds)
     }
 
     fn is_delta(&self) -> bool {
@@ -299,6 +265,10 @@ impl Light for AreaLight {
         Effects::AREA_LIGHTS
     }
 
+    fn emission(&self) -> Option<&dyn radiant_core::Emission> {
+        Some(self)
+    }
+
     fn gpu(&self) -> Option<GpuModule> {
         let mut params = GpuParams::new()
             .rgb(self.radiance)
@@ -323,6 +293,63 @@ impl Light for AreaLight {
             params = params.u32(part);
         }
         Some(GpuModule::new("area", include_str!("area.wgsl"), params))
+    }
+}
+
+use crate::emitted::cosine_direction;
+use radiant_core::{Emission, EmissionKind, EmissionPdf, EmissionSample, EmittedRay};
+
+/// Emitted rays: a part in proportion to its area, a point uniformly on
+/// it (density 1 / total area), a cosine-weighted direction about its
+/// normal.
+impl Emission for AreaLight {
+    fn kind(&self) -> EmissionKind {
+        EmissionKind::Surface
+    }
+
+    fn sample_emission(&self, u_pos: &[Vec2], u_dir: &[Vec2], out: &mut [EmissionSample]) {
+        for ((up, ud), o) in u_pos.iter().zip(u_dir).zip(out.iter_mut()) {
+            let (part, ux) = self.pick(up.x);
+            let u = Vec2::new(ux, up.y);
+            let (p, n) = match self.parts[part] {
+                Part::Triangle([a, b, c], n) => {
+                    let bary = square_to_uniform_triangle(u);
+                    (a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y, n)
+                }
+                Part::Rectangle(rect) => (rect.point(u), rect.n),
+                Part::Sphere(centre, r) => {
+                    let n = square_to_uniform_sphere(u);
+                    (centre + n * r, n)
+                }
+            };
+            let (dir, pdf_dir) = cosine_direction(n, *ud);
+            // The first primitive of the part (parts are consecutive).
+            let primitive = self.part_of.partition_point(|&q| (q as usize) < part) as u32;
+            *o = EmissionSample {
+                p,
+                n,
+                dir,
+                radiance: self.radiance,
+                pdf_pos: if pdf_dir > 0.0 { 1.0 / self.area } else { 0.0 },
+                pdf_dir,
+                kind: EmissionKind::Surface,
+                primitive,
+            };
+        }
+    }
+
+    fn emission_pdf(&self, rays: &[EmittedRay], out: &mut [EmissionPdf]) {
+        for (r, o) in rays.iter().zip(out.iter_mut()) {
+            let cos = r.n.dot(r.dir);
+            *o = if cos > 0.0 {
+                EmissionPdf {
+                    pdf_pos: 1.0 / self.area,
+                    pdf_dir: cos * std::f32::consts::FRAC_1_PI,
+                }
+            } else {
+                EmissionPdf::default()
+            };
+        }
     }
 }
 

@@ -80,6 +80,10 @@ impl Light for DirectionalLight {
         Effects::DELTA_LIGHTS
     }
 
+    fn emission(&self) -> Option<&dyn radiant_core::Emission> {
+        Some(self)
+    }
+
     fn gpu(&self) -> Option<GpuModule> {
         let params = GpuParams::new().vec3(self.back()).rgb(self.irradiance);
         Some(GpuModule::new(
@@ -87,6 +91,47 @@ impl Light for DirectionalLight {
             include_str!("directional.wgsl"),
             params,
         ))
+    }
+}
+
+/// Emitted rays: along the light's direction from a point drawn uniformly
+/// on the disc that covers the scene, upstream of it.
+impl radiant_core::Emission for DirectionalLight {
+    fn kind(&self) -> radiant_core::EmissionKind {
+        radiant_core::EmissionKind::Directional
+    }
+
+    fn sample_emission(
+        &self,
+        u_pos: &[Vec2],
+        _u_dir: &[Vec2],
+        out: &mut [radiant_core::EmissionSample],
+    ) {
+        for (u, o) in u_pos.iter().zip(out.iter_mut()) {
+            let (p, pdf_pos) = crate::emitted::disc_origin(&self.sphere, self.direction, *u);
+            *o = radiant_core::EmissionSample {
+                p,
+                n: Vec3::ZERO,
+                dir: self.direction,
+                radiance: self.irradiance,
+                pdf_pos,
+                pdf_dir: 1.0,
+                kind: radiant_core::EmissionKind::Directional,
+                primitive: 0,
+            };
+        }
+    }
+
+    fn emission_pdf(
+        &self,
+        rays: &[radiant_core::EmittedRay],
+        out: &mut [radiant_core::EmissionPdf],
+    ) {
+        let pdf = radiant_core::EmissionPdf {
+            pdf_pos: crate::emitted::disc_pdf(&self.sphere),
+            pdf_dir: 1.0,
+        };
+        out[..rays.len()].fill(pdf);
     }
 }
 

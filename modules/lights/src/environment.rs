@@ -423,6 +423,62 @@ impl Light for EnvironmentLight {
     fn effects(&self) -> Effects {
         Effects::ENVIRONMENT
     }
+
+    fn emission(&self) -> Option<&dyn radiant_core::Emission> {
+        Some(self)
+    }
+}
+
+/// Emitted rays: a direction towards the light drawn as next-event
+/// estimation draws it (the map's luminance), travelling against it from a
+/// point drawn uniformly on the disc that covers the scene.
+impl radiant_core::Emission for EnvironmentLight {
+    fn kind(&self) -> radiant_core::EmissionKind {
+        radiant_core::EmissionKind::Infinite
+    }
+
+    fn sample_emission(
+        &self,
+        u_pos: &[Vec2],
+        u_dir: &[Vec2],
+        out: &mut [radiant_core::EmissionSample],
+    ) {
+        for ((up, ud), o) in u_pos.iter().zip(u_dir).zip(out.iter_mut()) {
+            let (local, radiance, pdf_dir) = match &self.emission {
+                Emission::Constant(c) => (square_to_uniform_sphere(*ud), *c, UNIFORM_SPHERE_PDF),
+                Emission::Map(m) => {
+                    let (d, su, sv, pdf) = m.sample(*ud);
+                    (d, m.lookup(su, sv), pdf)
+                }
+            };
+            let dir = -(self.to_render * local);
+            let (p, pdf_pos) = crate::emitted::disc_origin(&self.sphere, dir, *up);
+            *o = radiant_core::EmissionSample {
+                p,
+                n: Vec3::ZERO,
+                dir,
+                radiance,
+                pdf_pos: if pdf_dir > 0.0 { pdf_pos } else { 0.0 },
+                pdf_dir,
+                kind: radiant_core::EmissionKind::Infinite,
+                primitive: 0,
+            };
+        }
+    }
+
+    fn emission_pdf(
+        &self,
+        rays: &[radiant_core::EmittedRay],
+        out: &mut [radiant_core::EmissionPdf],
+    ) {
+        let pdf_pos = crate::emitted::disc_pdf(&self.sphere);
+        for (r, o) in rays.iter().zip(out.iter_mut()) {
+            *o = radiant_core::EmissionPdf {
+                pdf_pos,
+                pdf_dir: self.eval_local(self.to_light * -r.dir).pdf,
+            };
+        }
+    }
 }
 
 /// The rotation part of a light transform, or an error if it is not one.

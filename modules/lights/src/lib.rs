@@ -7,6 +7,7 @@
 mod area;
 mod delta;
 mod directional;
+mod emitted;
 mod environment;
 mod map_file;
 mod params;

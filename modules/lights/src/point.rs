@@ -4,8 +4,7 @@ use crate::delta::sample_delta;
 use crate::params::{check_colour, place};
 use radiant_core::glam::{DVec3, Vec2, Vec3};
 use radiant_core::{
-    BuildContext, Color, Effects, GpuModule, GpuParams, Light, LightBounds, LightSample, Numbers,
-    ParamDoc,
+    BuildContext, Color, Effects, GpuModule, GpuParams, Light, LightSample, Numbers, ParamDoc,
     ParamError, Params, Registry, Rgb, luminance,
 };
 use serde::Deserialize;
@@ -54,16 +53,6 @@ impl Light for PointLight {
         4.0 * std::f32::consts::PI * luminance(self.intensity)
     }
 
-    fn bounds(&self) -> Option<LightBounds> {
-        Some(LightBounds::point(
-            self.position,
-            luminance(self.intensity),
-            Vec3::Z,
-            -1.0,
-            0.0,
-        ))
-    }
-
     fn is_delta(&self) -> bool {
         true
     }
@@ -84,9 +73,53 @@ impl Light for PointLight {
         Effects::DELTA_LIGHTS
     }
 
+    fn emission(&self) -> Option<&dyn radiant_core::Emission> {
+        Some(self)
+    }
+
     fn gpu(&self) -> Option<GpuModule> {
         let params = GpuParams::new().vec3(self.position).rgb(self.intensity);
         Some(GpuModule::new("point", include_str!("point.wgsl"), params))
+    }
+}
+
+/// Emitted rays: from the light's position, uniformly over the sphere.
+impl radiant_core::Emission for PointLight {
+    fn kind(&self) -> radiant_core::EmissionKind {
+        radiant_core::EmissionKind::Point
+    }
+
+    fn sample_emission(
+        &self,
+        _u_pos: &[Vec2],
+        u_dir: &[Vec2],
+        out: &mut [radiant_core::EmissionSample],
+    ) {
+        use radiant_core::warp::{UNIFORM_SPHERE_PDF, square_to_uniform_sphere};
+        for (u, o) in u_dir.iter().zip(out.iter_mut()) {
+            *o = radiant_core::EmissionSample {
+                p: self.position,
+                n: Vec3::ZERO,
+                dir: square_to_uniform_sphere(*u),
+                radiance: self.intensity,
+                pdf_pos: 1.0,
+                pdf_dir: UNIFORM_SPHERE_PDF,
+                kind: radiant_core::EmissionKind::Point,
+                primitive: 0,
+            };
+        }
+    }
+
+    fn emission_pdf(
+        &self,
+        rays: &[radiant_core::EmittedRay],
+        out: &mut [radiant_core::EmissionPdf],
+    ) {
+        let pdf = radiant_core::EmissionPdf {
+            pdf_pos: 1.0,
+            pdf_dir: radiant_core::warp::UNIFORM_SPHERE_PDF,
+        };
+        out[..rays.len()].fill(pdf);
     }
 }
 

@@ -6,8 +6,7 @@ use crate::delta::sample_delta;
 use crate::params::{axis, check_colour, place};
 use radiant_core::glam::{DVec3, Vec2, Vec3};
 use radiant_core::{
-    BuildContext, Color, Effects, GpuModule, GpuParams, Light, LightBounds, LightSample, Numbers,
-    ParamDoc,
+    BuildContext, Color, Effects, GpuModule, GpuParams, Light, LightSample, Numbers, ParamDoc,
     ParamError, Params, Registry, Rgb, luminance,
 };
 use serde::Deserialize;
@@ -128,17 +127,6 @@ impl Light for SpotLight {
         luminance(self.intensity) * self.falloff_integral()
     }
 
-    fn bounds(&self) -> Option<LightBounds> {
-        // Full intensity within the beam, falling off over cutoff − beam.
-        Some(LightBounds::point(
-            self.position,
-            luminance(self.intensity),
-            self.axis,
-            self.cos_beam,
-            (self.cutoff - self.beam).cos(),
-        ))
-    }
-
     fn is_delta(&self) -> bool {
         true
     }
@@ -160,6 +148,10 @@ impl Light for SpotLight {
         Effects::DELTA_LIGHTS
     }
 
+    fn emission(&self) -> Option<&dyn radiant_core::Emission> {
+        Some(self)
+    }
+
     fn gpu(&self) -> Option<GpuModule> {
         let params = GpuParams::new()
             .vec3(self.position)
@@ -167,6 +159,54 @@ impl Light for SpotLight {
             .rgb(self.intensity)
             .f32s([self.cutoff, self.beam, self.cos_cutoff, self.cos_beam]);
         Some(GpuModule::new("spot", include_str!("spot.wgsl"), params))
+    }
+}
+
+/// Emitted rays: from the light's position, uniformly over the cone of
+/// `cutoff_angle`, carrying the falloff.
+impl radiant_core::Emission for SpotLight {
+    fn kind(&self) -> radiant_core::EmissionKind {
+        radiant_core::EmissionKind::Point
+    }
+
+    fn sample_emission(
+        &self,
+        _u_pos: &[Vec2],
+        u_dir: &[Vec2],
+        out: &mut [radiant_core::EmissionSample],
+    ) {
+        let frame = radiant_core::Frame::from_normal(self.axis);
+        let pdf_dir = 1.0 / (std::f32::consts::TAU * (1.0 - self.cos_cutoff));
+        for (u, o) in u_dir.iter().zip(out.iter_mut()) {
+            let cos = 1.0 - u.x * (1.0 - self.cos_cutoff);
+            let sin = (1.0 - cos * cos).max(0.0).sqrt();
+            let (s, c) = (std::f32::consts::TAU * u.y).sin_cos();
+            *o = radiant_core::EmissionSample {
+                p: self.position,
+                n: Vec3::ZERO,
+                dir: frame.to_world(Vec3::new(sin * c, sin * s, cos)),
+                radiance: self.intensity * self.falloff(cos),
+                pdf_pos: 1.0,
+                pdf_dir,
+                kind: radiant_core::EmissionKind::Point,
+                primitive: 0,
+            };
+        }
+    }
+
+    fn emission_pdf(
+        &self,
+        rays: &[radiant_core::EmittedRay],
+        out: &mut [radiant_core::EmissionPdf],
+    ) {
+        let pdf_dir = 1.0 / (std::f32::consts::TAU * (1.0 - self.cos_cutoff));
+        for (r, o) in rays.iter().zip(out.iter_mut()) {
+            let inside = r.dir.dot(self.axis) > self.cos_cutoff;
+            *o = radiant_core::EmissionPdf {
+                pdf_pos: 1.0,
+                pdf_dir: if inside { pdf_dir } else { 0.0 },
+            };
+        }
     }
 }
 
