@@ -34,6 +34,7 @@ pub mod gpu;
 pub mod hash;
 pub mod input_file;
 pub mod light;
+pub mod light_bounds;
 pub mod medium;
 pub mod memory;
 pub mod params;
@@ -55,6 +56,7 @@ pub use light::{
     Emission, EmissionKind, EmissionPdf, EmissionSample, EmittedRay, EmitterEval, EmitterHit,
     Light, LightSample,
 };
+pub use light_bounds::LightBounds;
 pub use medium::{Coefficients, Medium, Phase};
 pub use params::{Color, Numbers, ParamError, Params, TextureInput};
 pub use registry::{ModuleInfo, ModuleKind, ParamDoc, Registry};

@@ -98,6 +98,15 @@ pub trait Light: Send + Sync {
         None
     }
 
+    /// Where the light is and where it emits, for selection that weighs
+    /// lights by their importance at the shading point
+    /// (`light_selection: spatial`). `None` (the default) for lights at
+    /// infinity and lights that do not say: spatial selection then gives
+    /// them a fixed share of the samples.
+    fn bounds(&self) -> Option<crate::LightBounds> {
+        None
+    }
+
     /// The light's GPU side (see [`crate::gpu`]), `None` where the type has
     /// none.
     fn gpu(&self) -> Option<GpuModule> {

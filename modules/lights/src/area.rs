@@ -15,7 +15,7 @@ use radiant_core::glam::{Vec2, Vec3};
 use radiant_core::warp::{square_to_uniform_sphere, square_to_uniform_triangle};
 use radiant_core::{
     Color, Effects, EmitterEval, EmitterHit, EmitterShape, GpuModule, GpuParams, Light,
-    LightSample, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb, luminance,
+    LightBounds, LightSample, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb, luminance,
 };
 use serde::Deserialize;
 
@@ -67,6 +67,8 @@ pub struct AreaLight {
     /// Probability of picking each part (its share of the area).
     probability: Vec<f32>,
     area: f32,
+    /// Box, normal cone and power, for spatial light selection.
+    bounds: LightBounds,
 }
 
 impl AreaLight {
@@ -108,6 +110,7 @@ impl AreaLight {
             return Err("an area light needs a shape with a positive, finite surface area".into());
         }
         let probability = parts.iter().map(|p| (p.area() / total) as f32).collect();
+        let bounds = shape_bounds(&shape, luminance(radiance) * total as f32);
         Ok(Self {
             radiance,
             parts,
@@ -115,6 +118,7 @@ impl AreaLight {
             cdf,
             probability,
             area: total as f32,
+            bounds,
         })
     }
 
@@ -214,9 +218,39 @@ impl AreaLight {
     }
 }
 
+/// The box of `shape`, the cone of its normals (every direction where it
+/// has a sphere) and its power `phi`.
+fn shape_bounds(shape: &EmitterShape, phi: f32) -> LightBounds {
+    let (mut min, mut max) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    let mut normal_sum = Vec3::ZERO;
+    for [a, b, c] in &shape.triangles {
+        min = min.min(a.min(b.min(*c)));
+        max = max.max(a.max(b.max(*c)));
+        normal_sum += (*b - *a).cross(*c - *a);
+    }
+    for &(centre, r) in &shape.spheres {
+        min = min.min(centre - Vec3::splat(r));
+        max = max.max(centre + Vec3::splat(r));
+    }
+    let normals = shape
+        .triangles
+        .iter()
+        .map(|[a, b, c]| (*b - *a).cross(*c - *a).normalize_or_zero());
+    let sum = if shape.spheres.is_empty() {
+        normal_sum
+    } else {
+        Vec3::ZERO
+    };
+    LightBounds::surface(min, max, phi, sum, normals)
+}
+
 impl Light for AreaLight {
     fn power(&self) -> f32 {
         luminance(self.radiance) * self.area * std::f32::consts::PI
+    }
+
+    fn bounds(&self) -> Option<LightBounds> {
+        Some(self.bounds)
     }
 
     fn is_delta(&self) -> bool {

@@ -4,8 +4,8 @@ use crate::delta::sample_delta;
 use crate::params::{check_colour, place};
 use radiant_core::glam::{DVec3, Vec2, Vec3};
 use radiant_core::{
-    BuildContext, Color, Effects, GpuModule, GpuParams, Light, LightSample, Numbers, ParamDoc,
-    ParamError, Params, Registry, Rgb, luminance,
+    BuildContext, Color, Effects, GpuModule, GpuParams, Light, LightBounds, LightSample, Numbers,
+    ParamDoc, ParamError, Params, Registry, Rgb, luminance,
 };
 use serde::Deserialize;
 
@@ -51,6 +51,16 @@ impl PointLight {
 impl Light for PointLight {
     fn power(&self) -> f32 {
         4.0 * std::f32::consts::PI * luminance(self.intensity)
+    }
+
+    fn bounds(&self) -> Option<LightBounds> {
+        Some(LightBounds::point(
+            self.position,
+            luminance(self.intensity),
+            Vec3::Z,
+            -1.0,
+            0.0,
+        ))
     }
 
     fn is_delta(&self) -> bool {

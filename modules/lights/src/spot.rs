@@ -6,8 +6,8 @@ use crate::delta::sample_delta;
 use crate::params::{axis, check_colour, place};
 use radiant_core::glam::{DVec3, Vec2, Vec3};
 use radiant_core::{
-    BuildContext, Color, Effects, GpuModule, GpuParams, Light, LightSample, Numbers, ParamDoc,
-    ParamError, Params, Registry, Rgb, luminance,
+    BuildContext, Color, Effects, GpuModule, GpuParams, Light, LightBounds, LightSample, Numbers,
+    ParamDoc, ParamError, Params, Registry, Rgb, luminance,
 };
 use serde::Deserialize;
 
@@ -125,6 +125,17 @@ impl SpotLight {
 impl Light for SpotLight {
     fn power(&self) -> f32 {
         luminance(self.intensity) * self.falloff_integral()
+    }
+
+    fn bounds(&self) -> Option<LightBounds> {
+        // Full intensity within the beam, falling off over cutoff − beam.
+        Some(LightBounds::point(
+            self.position,
+            luminance(self.intensity),
+            self.axis,
+            self.cos_beam,
+            (self.cutoff - self.beam).cos(),
+        ))
     }
 
     fn is_delta(&self) -> bool {
