@@ -29,7 +29,7 @@ use crate::film::{Reconstruction, TileFilm};
 use glam::{Vec2, Vec3};
 use radiant_core::{
     BsdfEval, BsdfSample, CameraRays, Effects, EmitterEval, EmitterHit, LightSample, Rgb, SampleId,
-    ShadeContext, Shader, SurfaceBatch,
+    Sampler, ShadeContext, Shader, SurfaceBatch,
 };
 
 /// Sampler dimensions used by the camera (film jitter, lens); under motion
@@ -271,7 +271,7 @@ impl Wavefront {
             zeroed(&mut self.first_hits, n);
         }
         if scene.settings.max_depth != 0 {
-            self.trace_paths(scene);
+            self.trace_paths(scene, scene.sampler.as_ref());
         }
         // One sample index at a time over the batch's pixels (slots are
         // pixel-major), each block of sample indices ended into the tile's
@@ -336,9 +336,7 @@ impl Wavefront {
             }
         }
         fit(&mut self.film, n);
-        fit(&mut self.u2, n);
         scene.sampler.fill_2d(&self.ids, 0, &mut self.film);
-        scene.sampler.fill_2d(&self.ids, 2, &mut self.u2);
         if let Reconstruction::Importance(filter) = reconstruction {
             // The sample's offset from its pixel's centre, drawn from the
             // filter, and its weight f/pdf.
@@ -360,6 +358,40 @@ impl Wavefront {
                 }
             }
         }
+        self.start_paths(scene, scene.sampler.as_ref(), n);
+    }
+
+    /// Traces one camera path per raster position `raster[i]` (pixels from
+    /// the image's top left corner) as sample `ids[i]` of `sampler` — the
+    /// lens, the shutter time and every bounce draw from it, from
+    /// dimension 2 on — and returns each path's radiance. The Metropolis
+    /// integrators trace their chains' proposals with it (their sampler
+    /// serves the chains' primary samples; `ids[i].pixel` is the chain).
+    pub fn trace_raster(
+        &mut self,
+        scene: &RenderScene,
+        sampler: &dyn Sampler,
+        ids: &[SampleId],
+        raster: &[Vec2],
+    ) -> &[Rgb] {
+        let n = ids.len().min(raster.len());
+        fit(&mut self.ids, n);
+        self.ids.copy_from_slice(&ids[..n]);
+        fit(&mut self.film, n);
+        self.film.copy_from_slice(&raster[..n]);
+        self.collect_aovs = false;
+        self.start_paths(scene, sampler, n);
+        if scene.settings.max_depth != 0 {
+            self.trace_paths(scene, sampler);
+        }
+        &self.radiance[..n]
+    }
+
+    /// Starts the camera paths of `self.ids` at the raster positions
+    /// `self.film`: lens samples, rays, shutter times, path state.
+    fn start_paths(&mut self, scene: &RenderScene, sampler: &dyn Sampler, n: usize) {
+        fit(&mut self.u2, n);
+        sampler.fill_2d(&self.ids, 2, &mut self.u2);
         fit(&mut self.origin, n);
         fit(&mut self.dir, n);
         fit(&mut self.u1, n);
@@ -375,9 +407,7 @@ impl Wavefront {
         if scene.motion_blur() {
             // Each path lives at one time of the shutter (a box shutter).
             fit(&mut self.time, n);
-            scene
-                .sampler
-                .fill_1d(&self.ids, CAMERA_DIMS, &mut self.time);
+            sampler.fill_1d(&self.ids, CAMERA_DIMS, &mut self.time);
             if let Some(motion) = &scene.camera_motion {
                 move_camera_rays(motion, &self.time, &mut self.origin, &mut self.dir);
             }
@@ -408,7 +438,7 @@ impl Wavefront {
         self.live.extend(0..n as u32);
     }
 
-    fn trace_paths(&mut self, scene: &RenderScene) {
+    fn trace_paths(&mut self, scene: &RenderScene, sampler: &dyn Sampler) {
         let s = &scene.settings;
         let max_depth = if s.max_depth < 0 {
             UNLIMITED_DEPTH_CAP
@@ -459,9 +489,9 @@ impl Wavefront {
                 }
             }
             if has_lights {
-                self.sample_lights(scene, n, base);
+                self.sample_lights(scene, sampler, n, base);
             }
-            self.shade(scene, base);
+            self.shade(scene, sampler, base);
             if has_media {
                 self.media.shade_events(
                     scene,
@@ -476,7 +506,7 @@ impl Wavefront {
             if has_lights {
                 self.next_event(scene, n);
             }
-            self.continue_paths(scene, depth, base);
+            self.continue_paths(scene, sampler, depth, base);
             if has_media {
                 self.media.after_bounce(
                     scene,
@@ -702,9 +732,9 @@ impl Wavefront {
 
     /// Chooses a light per path and samples a point on it, one module call
     /// per light.
-    fn sample_lights(&mut self, scene: &RenderScene, n: usize, base: u32) {
+    fn sample_lights(&mut self, scene: &RenderScene, sampler: &dyn Sampler, n: usize, base: u32) {
         fit(&mut self.u2, n);
-        scene.sampler.fill_2d(&self.ids_k, base + 1, &mut self.u2);
+        sampler.fill_2d(&self.ids_k, base + 1, &mut self.u2);
         fit(&mut self.light, n);
         fit(&mut self.light_prob, n);
         fit(&mut self.light_sample, n);
@@ -719,7 +749,7 @@ impl Wavefront {
             }
             light.sample(&self.refs, &self.u2, &mut self.light_sample);
         } else {
-            self.sample_chosen_lights(scene, n, base);
+            self.sample_chosen_lights(scene, sampler, n, base);
         }
         // Directions towards the light samples, in the local frames.
         fit(&mut self.nee_wi, n);
@@ -736,9 +766,15 @@ impl Wavefront {
 
     /// Chooses a light per path in proportion to power and samples the
     /// chosen lights, one module call per light.
-    fn sample_chosen_lights(&mut self, scene: &RenderScene, n: usize, base: u32) {
+    fn sample_chosen_lights(
+        &mut self,
+        scene: &RenderScene,
+        sampler: &dyn Sampler,
+        n: usize,
+        base: u32,
+    ) {
         fit(&mut self.u1, n);
-        scene.sampler.fill_1d(&self.ids_k, base, &mut self.u1);
+        sampler.fill_1d(&self.ids_k, base, &mut self.u1);
         for k in 0..n {
             let at = self.its[self.live[k] as usize].p;
             let (l, p) = scene.lights.select_at(at, self.u1[k]);
@@ -782,13 +818,13 @@ impl Wavefront {
 
     /// Calls each material's shader on its slice: BSDF samples for the
     /// continuation, and evaluations towards the light samples.
-    fn shade(&mut self, scene: &RenderScene, base: u32) {
+    fn shade(&mut self, scene: &RenderScene, sampler: &dyn Sampler, base: u32) {
         let n = self.live.len();
         fit(&mut self.u3, n);
         fit(&mut self.u1, n);
         fit(&mut self.u2, n);
-        scene.sampler.fill_1d(&self.ids_k, base + 3, &mut self.u1);
-        scene.sampler.fill_2d(&self.ids_k, base + 4, &mut self.u2);
+        sampler.fill_1d(&self.ids_k, base + 3, &mut self.u1);
+        sampler.fill_2d(&self.ids_k, base + 4, &mut self.u2);
         for ((u3, &u1), u2) in self.u3.iter_mut().zip(&self.u1).zip(&self.u2) {
             *u3 = Vec3::new(u1, u2.x, u2.y);
         }
@@ -917,10 +953,16 @@ impl Wavefront {
     }
 
     /// Follows the BSDF samples, applies Russian roulette and compacts.
-    fn continue_paths(&mut self, scene: &RenderScene, depth: u32, base: u32) {
+    fn continue_paths(
+        &mut self,
+        scene: &RenderScene,
+        sampler: &dyn Sampler,
+        depth: u32,
+        base: u32,
+    ) {
         let n = self.live.len();
         fit(&mut self.u1, n);
-        scene.sampler.fill_1d(&self.ids_k, base + 6, &mut self.u1);
+        sampler.fill_1d(&self.ids_k, base + 6, &mut self.u1);
         let rr = depth + 1 >= scene.settings.rr_depth;
         fit(&mut self.next_live, n);
         // Slices taken once (bounds in registers); survivors written by
