@@ -2,7 +2,9 @@
 //! limit, `--checkpoint` files appear while the render runs and are valid,
 //! a render interrupted by SIGINT after its first checkpoint and resumed
 //! gives the uninterrupted render's image bit for bit (a plain render
-//! too, its samples written when Ctrl-C stops it), a PNG render keeps
+//! too, its samples written when Ctrl-C stops it; a sequence, whose
+//! finished frames stay and whose current frame keeps its samples beside
+//! its file), a PNG render keeps
 //! its state beside it (and is encoded as a plain render encodes it), and
 //! wrong `--resume` inputs are refused naming the file.
 
@@ -226,6 +228,61 @@ fn a_plain_render_interrupted_keeps_its_samples_and_resumes() {
     rendered(&scene, &single, &["--spp", &spp]);
     assert!(!dir.path().join("single.png.resume.exr").exists());
     assert!(std::fs::read(&out).unwrap() == std::fs::read(&single).unwrap());
+}
+
+/// Waits for at most 120 s until `path` exists.
+fn wait_for(path: &Path) {
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while !path.exists() {
+        assert!(Instant::now() < deadline, "no {} in 120 s", path.display());
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// Ctrl-C in a sequence: the finished frames stay, the frame in progress
+/// keeps its samples as a state beside its file (and no image, so
+/// `--skip-existing` would render it again), the later frames are not
+/// started, the exit status is 130, and the kept frame resumed is the
+/// uninterrupted render of that frame byte for byte.
+#[test]
+fn an_interrupted_sequence_keeps_its_frames_and_the_current_ones_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = shot(dir.path(), "shot.yaml", "independent");
+    // About two seconds of samples per frame.
+    let probe = dir.path().join("probe.exr");
+    rendered(&scene, &probe, &["--time", "1s", "--spp", "1000000"]);
+    let spp = (samples_in(&probe) * 2).max(64).to_string();
+
+    let out = dir.path().join("seq_####.png");
+    let child = spawn_render(&scene, &out, &["--spp", &spp, "--frames", "1..3"]);
+    let frame = |n: u32| dir.path().join(format!("seq_{n:04}.png"));
+    wait_for(&frame(1));
+    std::thread::sleep(Duration::from_millis(300));
+    let o = interrupt(child);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(130), "{e}");
+    assert!(frame(1).exists(), "{e}");
+    assert!(!frame(2).exists() && !frame(3).exists(), "{e}");
+    let state = dir.path().join("seq_0002.png.resume.exr");
+    let held = samples_in(&state);
+    assert!(held >= 1 && held < spp.parse().unwrap(), "{held}: {e}");
+    assert!(
+        e.contains(&format!(
+            "interrupted: frame 2's {held} of {spp} spp kept in {}",
+            state.display()
+        )),
+        "{e}"
+    );
+    assert!(!dir.path().join("seq_0003.png.resume.exr").exists());
+
+    rendered(
+        &scene,
+        &frame(2),
+        &["--spp", &spp, "--frames", "2", "--resume", arg(&state)],
+    );
+    let single = dir.path().join("single.png");
+    rendered(&scene, &single, &["--spp", &spp, "--frames", "2"]);
+    assert!(std::fs::read(frame(2)).unwrap() == std::fs::read(&single).unwrap());
 }
 
 #[test]

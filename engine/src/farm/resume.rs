@@ -86,10 +86,18 @@ pub fn state_path(output: &Path) -> PathBuf {
     if is_exr(output) {
         output.to_path_buf()
     } else {
-        let mut name = output.as_os_str().to_os_string();
-        name.push(".resume.exr");
-        PathBuf::from(name)
+        frame_state_path(output)
     }
+}
+
+/// The file that holds the state of an interrupted frame of a sequence
+/// written to `output`: always `output` with `.resume.exr` appended, since
+/// the frame's own file must not exist until the frame is finished
+/// (`--skip-existing` leaves the frames whose file exists).
+pub fn frame_state_path(output: &Path) -> PathBuf {
+    let mut name = output.as_os_str().to_os_string();
+    name.push(".resume.exr");
+    PathBuf::from(name)
 }
 
 /// Whether `path` names an EXR file.

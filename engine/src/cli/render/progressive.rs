@@ -6,11 +6,18 @@
 //! progress with the image so far written (exit status 130; a second
 //! Ctrl-C quits at once, writing nothing more).
 //!
-//! A plain render of one frame goes through the same passes where its
-//! whole film fits in [`PLAIN_FILM_BYTES`], so that Ctrl-C keeps its
-//! samples too; it writes only the image when it ends, and the state only
-//! when it is interrupted. The film's sums are exact, so its image is the
-//! one the banded render (which larger frames keep) makes, bit for bit.
+//! A plain render goes through the same passes where its whole film fits
+//! in [`PLAIN_FILM_BYTES`], so that Ctrl-C keeps its samples too; it
+//! writes only the image when it ends, and the state only when it is
+//! interrupted. The film's sums are exact, so its image is the one the
+//! banded render (which larger frames keep) makes, bit for bit.
+//!
+//! In a sequence (`--frames A..B`), Ctrl-C stops the frame in progress
+//! after its pass and writes only its state, beside its file
+//! (`frame_0002.png.resume.exr`, `frame_0002.exr.resume.exr`): the frame's
+//! own file appears only when it is finished, so the finished frames stay,
+//! `--skip-existing` renders the interrupted one again, and `--frames 2
+//! --resume frame_0002.png.resume.exr` finishes it from its samples.
 
 use super::RenderArgs;
 use clap::Args;
@@ -130,6 +137,8 @@ pub(super) struct Frame<'a> {
     pub path: &'a Path,
     /// Raised by Ctrl-C.
     pub interrupt: &'a AtomicBool,
+    /// Whether the frame is one of a sequence's.
+    pub sequence: bool,
 }
 
 /// Renders `frame` as `args` say (from its resumed state where asked) and
@@ -174,6 +183,11 @@ pub(super) fn render(
     )?;
     if plain && outcome.stop == Stop::Done {
         write_image(frame, &film)?;
+    } else if frame.sequence && outcome.stop == Stop::Interrupted {
+        if outcome.samples > 0 {
+            let header = state_header(frame, &film, outcome.samples);
+            partial::write(&resume::frame_state_path(frame.path), &header, &film)?;
+        }
     } else if outcome.samples > 0 {
         write(frame, &film, outcome.samples)?;
     }
@@ -191,17 +205,22 @@ pub(super) fn render(
 /// state (one file for an EXR output), each atomically; the state first,
 /// so an image on disk never holds more than its state.
 fn write(frame: &Frame<'_>, film: &Film, samples: u32) -> Result<(), FrameError> {
-    let header = Header {
-        samples: 0..samples,
-        invalid_samples: film.invalid_samples,
-        ..frame.header.clone()
-    };
+    let header = state_header(frame, film, samples);
     let state = state_path(frame.path);
     partial::write(&state, &header, film)?;
     if state != frame.path {
         write_image(frame, film)?;
     }
     Ok(())
+}
+
+/// The state's header of `film`'s first `samples` samples of `frame`.
+fn state_header(frame: &Frame<'_>, film: &Film, samples: u32) -> Header {
+    Header {
+        samples: 0..samples,
+        invalid_samples: film.invalid_samples,
+        ..frame.header.clone()
+    }
 }
 
 /// Writes the image of `film`, encoded as the frame's settings say,
@@ -212,8 +231,9 @@ fn write_image(frame: &Frame<'_>, film: &Film) -> Result<(), FrameError> {
     Ok(())
 }
 
-/// What a progressive frame did, for the user.
-pub(super) fn describe(outcome: &Outcome, path: &Path, spp: u32) -> String {
+/// What a progressive frame did, for the user; `sequence` is the frame's
+/// number where it is one of a sequence's.
+pub(super) fn describe(outcome: &Outcome, path: &Path, spp: u32, sequence: Option<i64>) -> String {
     let state = state_path(path);
     let passes = format!(
         "{} passes (longest {:.2} s)",
@@ -229,6 +249,16 @@ pub(super) fn describe(outcome: &Outcome, path: &Path, spp: u32) -> String {
         ),
         Stop::Interrupted if outcome.samples == 0 => {
             "interrupted before the first pass ended: nothing written".to_string()
+        }
+        Stop::Interrupted if let Some(frame) = sequence => {
+            let state = resume::frame_state_path(path);
+            format!(
+                "interrupted: frame {frame}'s {} of {spp} spp kept in {} (its image is written \
+                 when it is finished); finish it with --frames {frame} --resume {}",
+                outcome.samples,
+                state.display(),
+                state.display()
+            )
         }
         Stop::Interrupted => format!(
             "interrupted: {} of {spp} spp written to {}; continue with --resume {}",
@@ -251,17 +281,15 @@ pub(super) struct Session {
     /// asked for; in a plain render from its first frame in passes (until
     /// then Ctrl-C quits at once, as it does in a banded render).
     handling: AtomicBool,
+    /// Whether it renders several frames.
+    sequence: bool,
 }
 
-/// The session of a progressive render where `args` ask for one (and
-/// nothing it cannot do with) or render one frame plainly, handling
-/// Ctrl-C from now on.
+/// The session of a progressive render where `args` ask for one, or of a
+/// plain render (of one frame or a sequence), handling Ctrl-C from now on
+/// where passes were asked for.
 pub(super) fn start(args: &RenderArgs) -> miette::Result<Option<Session>> {
     let p = &args.progressive;
-    let one_frame = args.frames.is_none_or(|(a, b)| a == b);
-    if !p.is_set() && !one_frame {
-        return Ok(None);
-    }
     if p.resume.is_some() && args.frames.is_some_and(|(a, b)| b > a) {
         miette::bail!(
             "--resume continues one frame, not frames {}..{}: resume each frame with its own file",
@@ -276,6 +304,7 @@ pub(super) fn start(args: &RenderArgs) -> miette::Result<Option<Session>> {
         interrupt: Arc::new(AtomicBool::new(false)),
         asked: p.is_set(),
         handling: AtomicBool::new(false),
+        sequence: args.frames.is_some_and(|(a, b)| b > a),
     };
     if session.asked {
         session.handle_interrupts()?;
@@ -336,11 +365,13 @@ impl Session {
             ),
             path,
             interrupt: &self.interrupt,
+            sequence: self.sequence,
         };
         let (written, outcome) = render(backend, &frame_state, &args.progressive, progress)
             .map_err(|e| miette::miette!("{e}"))?;
         if self.asked || outcome.stop != Stop::Done {
-            note(&describe(&outcome, path, scene.settings.spp));
+            let sequence = self.sequence.then_some(frame);
+            note(&describe(&outcome, path, scene.settings.spp, sequence));
         }
         Ok(written)
     }
