@@ -21,8 +21,10 @@ use crate::film::band::Bands;
 use crate::film::encode::{RowSink, write_encoded};
 use crate::film::memory::FrameTooLarge;
 use crate::film::{Film, Image, Reconstruction, TileFilm};
+use crate::integrators::adaptive::{self, TileRect};
+use crate::integrators::module::batches;
 use crate::integrators::{
-    Batch, ChainContext, Family, SplatFilm, TileContext, TileIntegrator, TileOutput, TileWorker,
+    ChainContext, Family, SplatFilm, TileContext, TileIntegrator, TileOutput, TileWorker,
 };
 use radiant_core::Rgb;
 use rayon::prelude::*;
@@ -33,8 +35,6 @@ use std::time::{Duration, Instant};
 
 /// Tile edge in pixels.
 const TILE: u32 = 16;
-/// Paths per wavefront batch (about): a tile's pixels × a few samples.
-const BATCH_PATHS: u32 = 1024;
 /// Tiles each thread renders per group, at least (see [`group_tile_rows`]).
 const GROUP_TILES_PER_THREAD: usize = 16;
 /// Groups of a whole-film pass are this many times larger: a pass may hold
@@ -80,19 +80,56 @@ pub fn try_render(scene: &RenderScene, progress: &Progress<'_>) -> Result<Render
             });
         }
     };
+    Ok(render_tiles(scene, tiles, progress, false)?.0)
+}
+
+/// Renders `scene` as [`try_render`] does (the same image) and also
+/// counts the image samples each pixel took (row-major): what adaptive
+/// sampling spent where (`--spp-map`). A Markov-chain integrator has no
+/// samples per pixel: `None` for it.
+pub fn try_render_counted(
+    scene: &RenderScene,
+    progress: &Progress<'_>,
+) -> Result<(Rendered, Option<Vec<u32>>), FrameTooLarge> {
+    match scene.integrator.family() {
+        Family::Tiles(tiles) => render_tiles(scene, tiles, progress, true),
+        Family::Chains(_) => Ok((try_render(scene, progress)?, None)),
+    }
+}
+
+/// Renders all samples of `scene` with the tile integrator `tiles` into a
+/// whole film (and splat film), counting each pixel's samples where
+/// `count`.
+fn render_tiles(
+    scene: &RenderScene,
+    tiles: &dyn TileIntegrator,
+    progress: &Progress<'_>,
+    count: bool,
+) -> Result<(Rendered, Option<Vec<u32>>), FrameTooLarge> {
+    let s = &scene.settings;
     let mut film = Film::try_new(s.width, s.height)?;
     let splats = frame_splats(scene, tiles)?;
-    let pass = Tiler::new(scene, tiles, splats.as_ref(), 0..s.spp, progress)
-        .whole(Tiler::render, |tiles| film.merge_all(tiles));
+    let mut tiler = Tiler::new(scene, tiles, splats.as_ref(), 0..s.spp, progress);
+    if count {
+        let counts = crate::film::memory::try_filled(s.width as usize * s.height as usize, 0u32)
+            .ok_or_else(|| FrameTooLarge::new(s.width, s.height))?;
+        tiler.counts = Some(std::sync::Mutex::new(counts));
+    }
+    let pass = tiler.whole(Tiler::render, |tiles| film.merge_all(tiles));
     let mut image = film.try_develop()?;
     let invalid_splats = add_splats(splats.as_ref(), &mut image, pass.samples);
-    Ok(Rendered {
+    let counts = tiler
+        .counts
+        .take()
+        .map(|c| c.into_inner().unwrap_or_else(|e| e.into_inner()));
+    let rendered = Rendered {
         image,
         time: pass.time,
         samples: pass.samples,
         rays: pass.rays,
         invalid_samples: film.invalid_samples + invalid_splats,
-    })
+    };
+    Ok((rendered, counts))
 }
 
 /// A black image of `width × height`, or what the frame needed.
@@ -388,8 +425,13 @@ struct Tiler<'a> {
     samples: Range<u32>,
     /// Camera paths of the whole pass.
     total: u64,
-    /// Camera paths traced so far.
+    /// Camera paths of the pass done so far (for progress).
     done: AtomicU64,
+    /// Image samples traced (adaptive sampling stops pixels early).
+    traced: AtomicU64,
+    /// Where asked for, each pixel's image samples (row-major, the whole
+    /// frame): `--spp-map`.
+    counts: Option<std::sync::Mutex<Vec<u32>>>,
     progress: &'a Progress<'a>,
 }
 
@@ -410,6 +452,8 @@ impl<'a> Tiler<'a> {
             total: s.width as u64 * s.height as u64 * samples.len() as u64,
             samples,
             done: AtomicU64::new(0),
+            traced: AtomicU64::new(0),
+            counts: None,
             progress,
         }
     }
@@ -438,7 +482,7 @@ impl<'a> Tiler<'a> {
         }
         Pass {
             time: start.elapsed(),
-            samples: self.total,
+            samples: self.traced.load(Ordering::Relaxed),
             rays,
         }
     }
@@ -501,35 +545,91 @@ impl<'a> Tiler<'a> {
         let (w, h) = (self.scene.settings.width, self.scene.settings.height);
         let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
         let pixels = (x1 - x0) * (y1 - y0);
-        let chunk = (BATCH_PATHS / pixels).max(1);
         let mut tile = TileFilm::new(x0, y0, x1, y1, (w, h), self.reconstruction.reach());
         let rays_before = worker.rays();
         let ctx = self.context();
-        let mut first = self.samples.start;
-        while first < self.samples.end {
-            let count = chunk.min(self.samples.end - first);
-            let batch = Batch {
-                x0,
-                y0,
-                x1,
-                y1,
-                first_sample: first,
-                samples: count,
+        let rect = TileRect {
+            x0,
+            y0,
+            x1,
+            y1,
+            width: w,
+        };
+        if let Some(a) = &self.scene.settings.adaptive {
+            let mut decisions = TileFilm::new(x0, y0, x1, y1, (w, h), self.reconstruction.reach());
+            let sink = SplatFilm::sink(self.scene.filter.as_ref());
+            let decision_ctx = TileContext {
+                splats: self.splats.map(|_| &sink),
+                ..self.context()
             };
+            let counts = adaptive::run_tile(a, self.samples.end, rect, |batch, decision, add| {
+                let (ctx, out) = if decision {
+                    let out = TileOutput {
+                        film: &mut decisions,
+                        aovs: None,
+                        samples: Some(add),
+                    };
+                    (&decision_ctx, out)
+                } else {
+                    let out = TileOutput {
+                        film: &mut tile,
+                        aovs: aovs.as_deref_mut(),
+                        samples: Some(add),
+                    };
+                    (&ctx, out)
+                };
+                worker.render(ctx, batch, out);
+            });
+            let traced = counts.iter().map(|&c| u64::from(c)).sum();
+            self.finish_tile(rect, &counts, traced);
+            return (tile, worker.rays() - rays_before);
+        }
+        for batch in batches((x0, y0, x1, y1), self.samples.clone()) {
             let out = TileOutput {
                 film: &mut tile,
                 aovs: aovs.as_deref_mut(),
                 samples: None,
             };
             worker.render(&ctx, batch, out);
-            first += count;
             if self.progress.is_active() {
-                let n = pixels as u64 * count as u64;
+                let n = pixels as u64 * batch.samples as u64;
                 let d = self.done.fetch_add(n, Ordering::Relaxed) + n;
                 self.progress.report(d, self.total);
             }
         }
+        let traced = u64::from(pixels) * self.samples.len() as u64;
+        self.traced.fetch_add(traced, Ordering::Relaxed);
+        if self.counts.is_some() {
+            self.record_counts(rect, &vec![self.samples.len() as u32; pixels as usize]);
+        }
         (tile, worker.rays() - rays_before)
+    }
+
+    /// Ends an adaptive tile: counts its `traced` samples, records its
+    /// pixels' `counts` where asked, and reports its share of the pass
+    /// (pixels × spp, whatever the pixels took) as done.
+    fn finish_tile(&self, rect: TileRect, counts: &[u32], traced: u64) {
+        self.traced.fetch_add(traced, Ordering::Relaxed);
+        self.record_counts(rect, counts);
+        if self.progress.is_active() {
+            let n = counts.len() as u64 * self.samples.len() as u64;
+            let d = self.done.fetch_add(n, Ordering::Relaxed) + n;
+            self.progress.report(d, self.total);
+        }
+    }
+
+    /// Writes a tile's per-pixel sample `counts` into the frame's, where
+    /// they are recorded.
+    fn record_counts(&self, t: TileRect, counts: &[u32]) {
+        let Some(frame) = &self.counts else {
+            return;
+        };
+        let mut frame = frame.lock().unwrap_or_else(|e| e.into_inner());
+        let tw = (t.x1 - t.x0) as usize;
+        for (row, y) in counts.chunks(tw.max(1)).zip(t.y0..) {
+            let start = (y * t.width + t.x0) as usize;
+            frame[start..start + row.len()].copy_from_slice(row);
+        }
     }
 
     /// What every batch of the frame shares.
@@ -668,6 +768,7 @@ pub(crate) mod tests {
         // The driver before integrators were modules: 16-pixel tiles,
         // batches of about 1024 paths through `Wavefront::render`, tiles
         // merged in order. The module's driver must give the same bits.
+        use crate::integrators::Batch;
         use crate::integrators::path::Wavefront;
         let (w, h, spp) = (40, 37, 12);
         let r = cornell_scene(w, h, spp);

@@ -77,7 +77,7 @@ pub fn run(args: &CompareArgs) -> miette::Result<()> {
 
 /// Writes FLIP's error map in its magma colours as an 8-bit PNG,
 /// atomically.
-fn write_heat_map(path: &Path, map: &nv_flip::FlipImageFloat) -> Result<(), String> {
+pub(crate) fn write_heat_map(path: &Path, map: &nv_flip::FlipImageFloat) -> Result<(), String> {
     let colours = map.apply_color_lut(&nv_flip::magma_lut());
     let bytes = colours.to_vec();
     let fail = |e: &dyn std::fmt::Display| format!("cannot write `{}`: {e}", path.display());

@@ -4,6 +4,7 @@
 mod partition;
 mod passes;
 mod progressive;
+mod spp_map;
 
 use super::diagnostic::report;
 use super::film_args::FilmArgs;
@@ -83,6 +84,12 @@ pub struct RenderArgs {
     film: FilmArgs,
     #[command(flatten)]
     passes: passes::PassArgs,
+    /// Also write a heat map of the samples each pixel took as a PNG
+    /// (magma: black none, yellow the most): where adaptive sampling
+    /// (`sampler: {adaptive: …}`) spent them. A run of `#` is the frame
+    /// number, as in `--output`. Renders on the CPU.
+    #[arg(long, value_name = "MAP.png")]
+    spp_map: Option<PathBuf>,
 }
 
 impl RenderArgs {
@@ -310,10 +317,14 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         }
         // Alpha is the coverage plane, which the passes record.
         let planes = args.passes.wanted(settings) || settings.output.alpha;
+        spp_map::check(args, planes)?;
         let session = progressive.as_ref().filter(|p| p.takes(s, planes));
         let rendered = pool.install(|| {
             let progress = Progress::new(&progress);
-            if let Some(session) = session {
+            if let Some(map) = &args.spp_map {
+                let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
+                spp_map::write(s, &path, &frame_path(map, frame), &progress, &note)
+            } else if let Some(session) = session {
                 let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
                 session.render(args, backend.as_mut(), (s, frame), &path, &progress, &note)
             } else if planes {

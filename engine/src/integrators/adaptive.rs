@@ -24,9 +24,11 @@
 //!   image's own samples instead is caught by its bias test.
 //! * **Robust.** μ is floored at [`MEAN_FLOOR`] (in luminance): without
 //!   it, a pixel that is nearly black (where a relative error is invisible)
-//!   would sample to `max_spp`. And a pixel whose decision samples are all
-//!   black stops only where its image samples are too (a caustic seen once
-//!   in the image but not yet in the decision keeps sampling).
+//!   would sample to `max_spp`. Nothing else is looked at: even "the image
+//!   samples saw light the decision samples did not" would make the count
+//!   depend on the image's values again. So a pixel lit by rare bright
+//!   paths (a caustic) whose decision samples all missed them stops at
+//!   `min_spp`, unbiased but noisy: raise `min_spp` for such scenes.
 //!
 //! Pixels are independent, so a tile runs its rounds alone: its pixels'
 //! counts and the decision statistics live in the tile ([`TileRounds`]),
@@ -34,6 +36,7 @@
 //! not passes). A round renders the runs of still-active pixels of each
 //! tile row as one batch each.
 
+use super::module::{Batch, batches};
 use radiant_core::{Rgb, luminance};
 use serde::Deserialize;
 
@@ -250,21 +253,115 @@ impl Moments {
 /// Whether a pixel has converged: the decision samples' statistics
 /// `decision` say that the mean of `image_samples` image samples is within
 /// `threshold` (relative, μ floored at [`MEAN_FLOOR`]) at quantile `z`.
-/// A pixel whose decision samples are all black but whose image samples
-/// are not has not.
-pub fn converged(
-    decision: &Moments,
-    image: &Moments,
-    image_samples: u32,
-    z: f64,
-    threshold: f64,
-) -> bool {
+pub fn converged(decision: &Moments, image_samples: u32, z: f64, threshold: f64) -> bool {
     let mean = decision.mean();
-    if mean <= 0.0 && image.sum > 0.0 {
-        return false;
-    }
     let half_width = z * decision.variance().sqrt() / f64::from(image_samples.max(1)).sqrt();
     half_width <= threshold * mean.max(MEAN_FLOOR)
+}
+
+/// A tile's rectangle [x0, x1) × [y0, y1) in a frame `width` pixels wide.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TileRect {
+    /// See [`Batch`].
+    pub x0: u32,
+    /// See [`Batch`].
+    pub y0: u32,
+    /// See [`Batch`].
+    pub x1: u32,
+    /// See [`Batch`].
+    pub y1: u32,
+    /// The frame's width.
+    pub width: u32,
+}
+
+/// Runs the rounds of adaptive sampling over one tile of a render of
+/// `spp` samples per pixel: `render(batch, decision, on_sample)` renders a
+/// batch — of image samples, or with `decision` of decision samples, which
+/// must not reach the image — and reports each sample's value by pixel.
+/// Returns the image samples each pixel took, row-major in the tile.
+pub fn run_tile(
+    a: &Adaptive,
+    spp: u32,
+    t: TileRect,
+    mut render: impl FnMut(Batch, bool, &mut dyn FnMut(u32, Rgb)),
+) -> Vec<u32> {
+    let tw = t.x1 - t.x0;
+    let len = (tw * (t.y1 - t.y0)) as usize;
+    let index = |pixel: u32| ((pixel / t.width - t.y0) * tw + pixel % t.width - t.x0) as usize;
+    let mut decision = vec![Moments::default(); len];
+    let mut counts = vec![0u32; len];
+    let mut active = vec![true; len];
+    let (first, most) = a.limits(spp);
+    let (z, per_round) = (a.z(), a.decision_samples());
+    let (mut n, mut decided) = (0, 0);
+    loop {
+        let target = if n == 0 {
+            first
+        } else {
+            (n + a.batch).min(most)
+        };
+        for_runs(&active, t, n..target, &mut |b| {
+            render(b, false, &mut |_, _| ())
+        });
+        let samples = DECISION_BASE + decided..DECISION_BASE + decided + per_round;
+        for_runs(&active, t, samples, &mut |b| {
+            render(b, true, &mut |p, v| {
+                decision[index(p)].add(sample_luminance(v))
+            })
+        });
+        decided += per_round;
+        for (c, _) in counts.iter_mut().zip(&active).filter(|(_, a)| **a) {
+            *c = target;
+        }
+        n = target;
+        if n >= most {
+            break;
+        }
+        let mut any = false;
+        for (on, d) in active.iter_mut().zip(&decision) {
+            *on = *on && !converged(d, n, z, a.threshold);
+            any |= *on;
+        }
+        if !any {
+            break;
+        }
+    }
+    counts
+}
+
+/// Cuts the sample indices `samples` of the active pixels of tile `t`
+/// into [`batches`]: the whole tile where every
+/// pixel is active, else each row's runs of active pixels.
+fn for_runs(
+    active: &[bool],
+    t: TileRect,
+    samples: std::ops::Range<u32>,
+    render: &mut dyn FnMut(Batch),
+) {
+    let tw = (t.x1 - t.x0) as usize;
+    let mut rect = |x0: u32, y0: u32, x1: u32, y1: u32| {
+        for batch in batches((x0, y0, x1, y1), samples.clone()) {
+            render(batch);
+        }
+    };
+    if active.iter().all(|a| *a) {
+        rect(t.x0, t.y0, t.x1, t.y1);
+        return;
+    }
+    for (row, y) in active.chunks(tw.max(1)).zip(t.y0..) {
+        let mut x = 0;
+        while x < row.len() {
+            if !row[x] {
+                x += 1;
+                continue;
+            }
+            let start = x;
+            while x < row.len() && row[x] {
+                x += 1;
+            }
+            rect(t.x0 + start as u32, y, t.x0 + x as u32, y + 1);
+        }
+    }
 }
 
 /// The luminance a sample's value is judged by (negative values, which
@@ -300,23 +397,18 @@ mod tests {
             flat.add(0.5);
             noisy.add(if i % 4 == 0 { 2.0 } else { 0.0 });
         }
-        let image = Moments {
-            n: 64,
-            sum: 1.0,
-            sum_sq: 1.0,
-        };
-        assert!(converged(&flat, &image, 64, z, 0.05));
-        assert!(!converged(&noisy, &image, 64, z, 0.05));
+        assert!(converged(&flat, 64, z, 0.05));
+        assert!(!converged(&noisy, 64, z, 0.05));
         // σ = √(16/15·0.75) ≈ 0.894, μ = 0.5: converged from n ≥ (z·σ/(0.05·μ))² ≈ 4913.
-        assert!(!converged(&noisy, &image, 4800, z, 0.05));
-        assert!(converged(&noisy, &image, 5000, z, 0.05));
-        // All-black decision samples stop a black pixel, not a lit one.
-        let black = Moments {
+        assert!(!converged(&noisy, 4800, z, 0.05));
+        assert!(converged(&noisy, 5000, z, 0.05));
+        // Near-black pixels are judged against the floor, not their mean.
+        let dim = Moments {
             n: 16,
-            ..Moments::default()
+            sum: 16e-6,
+            sum_sq: 32e-12,
         };
-        assert!(converged(&black, &Moments::default(), 64, z, 0.05));
-        assert!(!converged(&black, &image, 64, z, 0.05));
+        assert!(converged(&dim, 64, z, 0.05));
     }
 
     #[test]

@@ -170,6 +170,28 @@ pub struct ChainPass {
     pub rays: u64,
 }
 
+/// Paths per batch, about: a 16×16 tile's pixels × 4 samples.
+pub const BATCH_PATHS: u32 = 1024;
+
+/// The batches of about [`BATCH_PATHS`] paths that render the sample
+/// indices `samples` of the pixels [x0, x1) × [y0, y1): whole sample
+/// ranges of every pixel, in sample order.
+pub fn batches(
+    (x0, y0, x1, y1): (u32, u32, u32, u32),
+    samples: std::ops::Range<u32>,
+) -> impl Iterator<Item = Batch> {
+    let chunk = (BATCH_PATHS / ((x1 - x0) * (y1 - y0)).max(1)).max(1);
+    let end = samples.end;
+    samples.step_by(chunk as usize).map(move |first| Batch {
+        x0,
+        y0,
+        x1,
+        y1,
+        first_sample: first,
+        samples: chunk.min(end - first),
+    })
+}
+
 /// The extension table of `integrator` modules: before anything
 /// registered, an empty one.
 static NO_INTEGRATORS: Table<dyn Integrator> = Table::new();

@@ -76,6 +76,20 @@ impl SplatFilm {
         })
     }
 
+    /// A film of no pixels that drops every splat: the target of samples
+    /// whose splats must not reach the image (adaptive sampling's
+    /// decision samples).
+    pub fn sink(filter: &dyn Filter) -> Self {
+        Self {
+            width: 0,
+            height: 0,
+            table: FilterTable::new(filter),
+            norm: 0.0,
+            rows: Vec::new(),
+            invalid: Mutex::new(0),
+        }
+    }
+
     /// Adds `value`, landed at raster position `pos` (pixels, (0, 0) the
     /// top left corner), to the pixels within the filter's radius.
     pub fn splat(&self, pos: Vec2, value: Rgb) {
