@@ -16,29 +16,8 @@ use radiant_core::medium::{
     free_flight, henyey_greenstein, sample_henyey_greenstein, transmittance,
 };
 use radiant_tests::SplitMix;
-use radiant_tests::chi2::SIGNIFICANCE;
+use radiant_tests::chi2::{SIGNIFICANCE, invert_cdf, uniform_p_value};
 use radiant_tests::{check_against, render_edited, root};
-use statrs::distribution::{ChiSquared, ContinuousCDF};
-
-/// Pearson's chi-square p-value of `observed` counts against equal
-/// expected counts (the cells are equiprobable by construction).
-fn uniform_p_value(observed: &[f64]) -> f64 {
-    let n: f64 = observed.iter().sum();
-    let e = n / observed.len() as f64;
-    let chi2: f64 = observed.iter().map(|o| (o - e) * (o - e) / e).sum();
-    let dist = ChiSquared::new((observed.len() - 1) as f64).expect("dof > 0");
-    1.0 - dist.cdf(chi2)
-}
-
-/// The inverse of an increasing CDF on [lo, hi] by bisection (f64).
-fn invert(cdf: impl Fn(f64) -> f64, p: f64, lo: f64, hi: f64) -> f64 {
-    let (mut a, mut b) = (lo, hi);
-    for _ in 0..200 {
-        let m = 0.5 * (a + b);
-        if cdf(m) < p { a = m } else { b = m }
-    }
-    0.5 * (a + b)
-}
 
 /// The CDF of μ = wo·wi under Henyey–Greenstein, in closed form (the
 /// integral of its density from −1 to μ).
@@ -70,7 +49,7 @@ fn henyey_greenstein_sampling_matches_its_density() {
         // Cells of equal probability in μ (by the CDF) times equal cells
         // in φ about wo.
         let edges: Vec<f64> = (1..MU_CELLS)
-            .map(|k| invert(|m| hg_cdf(m, g64), k as f64 / MU_CELLS as f64, -1.0, 1.0))
+            .map(|k| invert_cdf(|m| hg_cdf(m, g64), k as f64 / MU_CELLS as f64, -1.0, 1.0))
             .collect();
         let wo = Vec3::new(0.36, -0.48, 0.8);
         let frame = radiant_core::Frame::from_normal(wo);
@@ -99,7 +78,7 @@ fn a_wrong_asymmetry_fails_the_hg_test() {
     // Power: samples of g = 0.3 binned by the cells of g = 0.32.
     let (g, wrong) = (0.3f32, 0.32f64);
     let edges: Vec<f64> = (1..50)
-        .map(|k| invert(|m| hg_cdf(m, wrong), k as f64 / 50.0, -1.0, 1.0))
+        .map(|k| invert_cdf(|m| hg_cdf(m, wrong), k as f64 / 50.0, -1.0, 1.0))
         .collect();
     let wo = Vec3::Z;
     let mut rng = SplitMix(5);
@@ -126,7 +105,7 @@ fn free_flight_distances_follow_the_mixture_of_exponentials() {
     };
     const CELLS: usize = 100;
     let edges: Vec<f64> = (1..CELLS)
-        .map(|k| invert(cdf, k as f64 / CELLS as f64, 0.0, 200.0))
+        .map(|k| invert_cdf(cdf, k as f64 / CELLS as f64, 0.0, 200.0))
         .collect();
     for (sigma, name) in [(SIGMA_T, "chromatic"), (Rgb::splat(1.5), "grey")] {
         let cdf = |t: f64| {
@@ -137,7 +116,7 @@ fn free_flight_distances_follow_the_mixture_of_exponentials() {
         };
         let edges: Vec<f64> = if name == "grey" {
             (1..CELLS)
-                .map(|k| invert(cdf, k as f64 / CELLS as f64, 0.0, 200.0))
+                .map(|k| invert_cdf(cdf, k as f64 / CELLS as f64, 0.0, 200.0))
                 .collect()
         } else {
             edges.clone()

@@ -240,3 +240,24 @@ impl Chi2 {
         }
     }
 }
+
+/// Pearson's chi-square p-value of `observed` counts against equal
+/// expected counts (for cells made equiprobable by construction, e.g. by
+/// [`invert_cdf`]).
+pub fn uniform_p_value(observed: &[f64]) -> f64 {
+    let n: f64 = observed.iter().sum();
+    let e = n / observed.len() as f64;
+    let chi2: f64 = observed.iter().map(|o| (o - e) * (o - e) / e).sum();
+    let dist = statrs::distribution::ChiSquared::new((observed.len() - 1) as f64).expect("dof > 0");
+    1.0 - statrs::distribution::ContinuousCDF::cdf(&dist, chi2)
+}
+
+/// The inverse of an increasing CDF on [lo, hi] at `p`, by bisection (f64).
+pub fn invert_cdf(cdf: impl Fn(f64) -> f64, p: f64, lo: f64, hi: f64) -> f64 {
+    let (mut a, mut b) = (lo, hi);
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        if cdf(m) < p { a = m } else { b = m }
+    }
+    0.5 * (a + b)
+}

@@ -4,7 +4,8 @@
 //! an index-matched `null` boundary, for the path integrator's medium
 //! stage (`integrators/medium.rs`).
 //!
-//! Media are built once per sequence (their parameters are not animated).
+//! Media are built once per sequence (their parameters are not animated),
+//! in render space (`render_origin`), which is fixed for a sequence.
 
 use crate::error::{SceneError, module_error};
 use crate::scene::media::NO_MEDIUM;
@@ -16,8 +17,10 @@ use std::collections::{BTreeSet, HashMap};
 
 /// The render data of the scene's media.
 pub struct MediaTable {
-    /// Coefficients per medium.
+    /// Coefficients per medium (where its density is 1).
     pub coefficients: Vec<Coefficients>,
+    /// The media, whose [`Medium::profile`] says how the density varies.
+    pub media: Vec<Box<dyn Medium>>,
     /// Phase function per medium.
     pub phases: Vec<Box<dyn Phase>>,
     /// Medium names, for messages.
@@ -59,6 +62,7 @@ impl MediaTable {
     pub(super) fn build(
         scene: &Scene,
         registry: &Registry,
+        render_origin: glam::DVec3,
         shaders: &[Box<dyn Shader>],
         modules: &mut BTreeSet<(ModuleKind, String)>,
     ) -> Result<Self, SceneError> {
@@ -66,8 +70,10 @@ impl MediaTable {
         let mut textures = TextureTable::default();
         let names = HashMap::new();
         let mut ctx = BuildContext::standalone(&scene.dir, &mut textures, &names);
+        ctx.render_origin = render_origin;
         let located = |spec: &ModuleSpec, e| module_error(&scene.file, spec, e);
         let mut coefficients = Vec::with_capacity(media.media.len());
+        let mut built = Vec::with_capacity(media.media.len());
         let mut phases = Vec::with_capacity(media.media.len());
         let isotropic = crate::scene::default_module("isotropic");
         for m in &media.media {
@@ -75,6 +81,7 @@ impl MediaTable {
                 .build::<dyn Medium>(&m.spec.type_name, &m.spec.params, &mut ctx)
                 .map_err(|e| located(&m.spec, e))?;
             coefficients.push(medium.coefficients());
+            built.push(medium);
             modules.insert((ModuleKind::Medium, m.spec.type_name.clone()));
             let spec = m.phase.as_ref().unwrap_or(&isotropic);
             let phase = registry
@@ -89,6 +96,7 @@ impl MediaTable {
         }
         Ok(Self {
             coefficients,
+            media: built,
             phases,
             names: media.media.iter().map(|m| m.name.clone()).collect(),
             camera: media.camera,

@@ -196,7 +196,13 @@ pub(super) fn build(
     let sphere = geometry.scene_sphere(&accel);
     let (modules, mut initial) =
         ModuleState::build(scene, registry, &settings, render_origin, emitters, sphere)?;
-    let media = super::MediaTable::build(scene, registry, &initial.shaders, &mut initial.modules)?;
+    let media = super::MediaTable::build(
+        scene,
+        registry,
+        render_origin,
+        &initial.shaders,
+        &mut initial.modules,
+    )?;
     let integrator = build_integrator(scene, registry, &mut initial.modules)?;
     let mut render = RenderScene {
         settings,

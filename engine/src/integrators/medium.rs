@@ -1,13 +1,18 @@
 //! The path integrator's medium stages: volumetric path tracing in
-//! homogeneous media, run only where the frame's effects contain
+//! homogeneous, height-fog and grid media, run only where the frame's effects contain
 //! [`Effects::MEDIA`](radiant_core::Effects) or
 //! [`Effects::NULL_INTERFACE`](radiant_core::Effects).
 //!
 //! The wavefront (`path.rs`) calls in at four points of a bounce:
 //!
 //! 1. after the closest hits, [`MediumState::sample_distances`] samples a
-//!    free-flight distance for every path travelling in a medium
-//!    ([`free_flight`]: hero channel, one-sample MIS over the channels).
+//!    free-flight distance for every path travelling in a medium, by the
+//!    medium's [`Profile`]: in closed form for uniform media
+//!    ([`free_flight`]: hero channel, one-sample MIS over the channels) and
+//!    for height fog (the same flight in the density integral, mapped back
+//!    to a distance), by delta tracking against the majorants for density
+//!    fields ([`delta_track`], random numbers from a [`Stream`] keyed by
+//!    the path's distance sample).
 //!    Paths that scatter before the surface leave the live list for this
 //!    bounce's surface stages and come back as *medium events*: an
 //!    interaction whose normal and frame lie along the ray, so that the
@@ -20,7 +25,8 @@
 //!    between phase and light sampling is the surfaces' power heuristic;
 //! 3. shadow rays return a transmittance ([`MediumState::transmittance`]):
 //!    they pass `null` boundaries, multiplying by the transmittance of each
-//!    medium segment, and stop at anything else;
+//!    medium segment (closed forms, or ratio tracking for density fields,
+//!    [`ratio_track`]), and stop at anything else;
 //! 4. after the continuation, [`MediumState::after_bounce`] moves paths
 //!    into the medium on the side they left a medium interface towards
 //!    (Mitsuba 3's rule: a surface without `interior`/`exterior` leaves the
@@ -37,8 +43,10 @@ use crate::accel::offset::offset_origin;
 use crate::extract::RenderScene;
 use crate::scene::media::NO_MEDIUM;
 use glam::{Vec2, Vec3};
-use radiant_core::medium::{free_flight, transmittance};
-use radiant_core::{BsdfEval, BsdfSample, Frame, Rgb, SampleId};
+use radiant_core::medium::{
+    FreeFlight, Stream, delta_track, free_flight, ratio_track, transmittance,
+};
+use radiant_core::{BsdfEval, BsdfSample, Coefficients, Frame, Profile, Rgb, SampleId};
 
 /// Sampler dimensions a bounce uses in scenes with media, after the
 /// surface's own: the hero channel and the distance.
@@ -132,7 +140,7 @@ impl MediumState {
             .sampler
             .fill_1d(&self.ids, dim + 1, &mut self.u_distance);
         self.events.clear();
-        let coefficients = &scene.media.coefficients[..];
+        let media = &scene.media;
         let mut m = 0;
         for k in 0..n {
             let slot = live[k];
@@ -144,34 +152,60 @@ impl MediumState {
                 m += 1;
                 continue;
             }
-            let c = coefficients[medium as usize];
+            let c = &media.coefficients[medium as usize];
             let len = dir[i].length();
+            let d = dir[i] / len;
             let t_max = if hits[i].prim == Hit::MISS.prim {
                 f32::INFINITY
             } else {
                 hits[i].t * len
             };
-            let flight = free_flight(c.sigma_t(), self.u_channel[k], self.u_distance[k], t_max);
-            if flight.scattered {
-                radiance[i] += beta[i] * flight.weight * c.sigma_a * c.emission;
-                beta[i] *= flight.weight * c.sigma_s;
-                if beta[i].max_element() <= 0.0 {
-                    continue;
+            let (u_channel, u) = (self.u_channel[k], self.u_distance[k]);
+            let interaction = match media.media[medium as usize].profile() {
+                Profile::Uniform => {
+                    let flight = free_flight(c.sigma_t(), u_channel, u, t_max);
+                    flight_weights(&flight, c, &mut beta[i], &mut radiance[i]);
+                    flight.scattered.then_some(flight.t)
                 }
-                let d = dir[i] / len;
-                its[i] = Interaction {
-                    p: origin[i] + d * flight.t,
-                    err: Vec3::ZERO,
-                    ng: d,
-                    frame: Frame::from_normal(d),
-                    uv: Vec2::ZERO,
-                };
-                self.event[i] = true;
-                self.events.push(slot);
-            } else {
-                beta[i] *= flight.weight;
-                live[m] = slot;
-                m += 1;
+                Profile::Height(h) => {
+                    // A homogeneous flight in the density integral D: the
+                    // density at the event cancels out of T/pdf·σs.
+                    let depth = h.integral(origin[i], d, t_max) as f32;
+                    let flight = free_flight(c.sigma_t(), u_channel, u, depth);
+                    flight_weights(&flight, c, &mut beta[i], &mut radiance[i]);
+                    flight
+                        .scattered
+                        .then(|| h.inverse(origin[i], d, f64::from(flight.t)).min(t_max))
+                }
+                Profile::Field(field) => {
+                    let id = ids[i];
+                    let mut rng = Stream::new(id.pixel, id.index, dim, u.to_bits());
+                    let tracked = delta_track(field, c, (origin[i], d, t_max), beta[i], &mut rng);
+                    radiance[i] += tracked.emitted;
+                    beta[i] = tracked.beta;
+                    tracked.scattered.then_some(tracked.t)
+                }
+            };
+            if beta[i].max_element() <= 0.0 {
+                // Absorbed (or a zero weight): the path ends here.
+                continue;
+            }
+            match interaction {
+                Some(t) => {
+                    its[i] = Interaction {
+                        p: origin[i] + d * t,
+                        err: Vec3::ZERO,
+                        ng: d,
+                        frame: Frame::from_normal(d),
+                        uv: Vec2::ZERO,
+                    };
+                    self.event[i] = true;
+                    self.events.push(slot);
+                }
+                None => {
+                    live[m] = slot;
+                    m += 1;
+                }
             }
         }
         live.truncate(m);
@@ -236,18 +270,22 @@ impl MediumState {
             };
             let tau = times.map_or(0.0, |t| t[j]);
             let end = origins[j] + dirs[j] * (1.0 - epsilon);
-            values[j] *= self.segment(scene, origins[j], end, start, tau);
+            // Ratio tracking's random numbers, keyed by the ray.
+            let key = origins[j].to_array().map(f32::to_bits);
+            let mut rng = Stream::new(key[0], key[1], key[2], end.x.to_bits() ^ slot);
+            values[j] *= self.segment(scene, (origins[j], end), start, tau, &mut rng);
         }
     }
 
-    /// The transmittance from `origin` to `end` starting in `medium`.
+    /// The transmittance from `origin` to `end` starting in `medium`
+    /// (ratio tracking in heterogeneous media draws from `rng`).
     fn segment(
         &self,
         scene: &RenderScene,
-        mut origin: Vec3,
-        end: Vec3,
+        (mut origin, end): (Vec3, Vec3),
         mut medium: u32,
         tau: f32,
+        rng: &mut Stream,
     ) -> Rgb {
         let media = &scene.media;
         let mut tr = Rgb::ONE;
@@ -255,11 +293,16 @@ impl MediumState {
             let d = end - origin;
             let hit = scene.accel.intersect_at(origin, d, 1.0, tau);
             if medium != NO_MEDIUM {
-                let t = hit.map_or(1.0, |h| h.t);
-                tr *= transmittance(
-                    media.coefficients[medium as usize].sigma_t(),
-                    t * d.length(),
-                );
+                let len = d.length();
+                let ray = (origin, d / len, hit.map_or(1.0, |h| h.t) * len);
+                let sigma_t = media.coefficients[medium as usize].sigma_t();
+                tr *= match media.media[medium as usize].profile() {
+                    Profile::Uniform => transmittance(sigma_t, ray.2),
+                    Profile::Height(h) => {
+                        transmittance(sigma_t, h.integral(ray.0, ray.1, ray.2) as f32)
+                    }
+                    Profile::Field(field) => ratio_track(field, sigma_t, ray, rng),
+                };
                 if tr.max_element() <= 0.0 {
                     return Rgb::ZERO;
                 }
@@ -306,6 +349,18 @@ impl MediumState {
             self.scatter_origin[i] = its[i].p;
             self.scatter_pdf[i] = prev_pdf[i];
         }
+    }
+}
+
+/// Applies a closed-form free flight's weights: σs·T/pdf (and the
+/// emission β·σa·Le·T/pdf) at an event, T/P(pass) where the ray passes.
+#[inline]
+fn flight_weights(flight: &FreeFlight, c: &Coefficients, beta: &mut Rgb, radiance: &mut Rgb) {
+    if flight.scattered {
+        *radiance += *beta * flight.weight * c.sigma_a * c.emission;
+        *beta *= flight.weight * c.sigma_s;
+    } else {
+        *beta *= flight.weight;
     }
 }
 

@@ -57,7 +57,7 @@ pub use light::{
     Light, LightSample,
 };
 pub use light_bounds::LightBounds;
-pub use medium::{Coefficients, Medium, Phase};
+pub use medium::{Coefficients, Medium, Phase, Profile};
 pub use params::{Color, Numbers, ParamError, Params, TextureInput};
 pub use registry::{ModuleInfo, ModuleKind, ParamDoc, Registry};
 pub use sampler::{SampleId, Sampler};

@@ -8,8 +8,18 @@
 //! (hero-channel sampling with one-sample MIS over the three colour
 //! channels, so chromatic media keep bounded weights), scatters with the
 //! medium's [`Phase`], and weights shadow rays by [`transmittance`].
+//! Media whose density varies give a [`Profile`]: exponential height fog
+//! in closed form ([`HeightProfile`], `height.rs`), or a density field
+//! tracked against majorants ([`DensityField`], [`delta_track`],
+//! [`ratio_track`], `tracking.rs`).
 //! Everything here runs only for scenes whose effect set contains
 //! [`crate::Effects::MEDIA`].
+
+mod height;
+mod tracking;
+
+pub use height::HeightProfile;
+pub use tracking::{DensityField, Stream, Tracked, delta_track, ratio_track};
 
 use crate::{BsdfEval, BsdfSample, Rgb};
 use glam::{Vec2, Vec3};
@@ -36,11 +46,27 @@ impl Coefficients {
 }
 
 /// A participating medium. Built once per frame; the integrator reads its
-/// coefficients once per batch, not per ray.
+/// coefficients and profile once per batch, not per ray.
 pub trait Medium: Send + Sync {
-    /// The medium's coefficients, the same everywhere in it (homogeneous
-    /// media).
+    /// The medium's coefficients where its density is 1 (everywhere, for
+    /// homogeneous media).
     fn coefficients(&self) -> Coefficients;
+    /// How its density varies in space; its coefficients at p are the
+    /// density at p times [`Medium::coefficients`].
+    fn profile(&self) -> Profile<'_> {
+        Profile::Uniform
+    }
+}
+
+/// The spatial variation of a medium's density.
+#[derive(Clone, Copy)]
+pub enum Profile<'a> {
+    /// Density 1 everywhere: free flights and transmittance in closed form.
+    Uniform,
+    /// Exponential in height: closed forms along rays.
+    Height(HeightProfile),
+    /// A field tracked against its majorants.
+    Field(&'a dyn DensityField),
 }
 
 /// A phase function: the angular distribution of scattering in a medium.
