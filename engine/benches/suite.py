@@ -648,10 +648,11 @@ def cmd_bench(args):
 
 # Where `profile` files a symbol (first match wins).
 CATEGORIES = [
-    ("scene load + BVH build", ("obvhs::", "tobj::", "extract::", "accel::wide::Collapse",
+    ("traversal (closest hits)", ("intersect_slots", "accel::triangle", "Accel::primitive",
+                                  "hit_sphere")),
+    ("load, BVH build, output", ("obvhs::", "tobj::", "extract::", "accel::wide::Collapse",
                                 "accel::blas::", "scene::", "ply_rs", "gltf", "png::", "image::",
                                 "miniz", "zune", "exr::", "load_image")),
-    ("traversal (closest hits)", ("intersect_slots", "accel::triangle", "Accel::primitive")),
     ("traversal (shadow rays)", ("occluded_each",)),
     ("shaders", ("radiant_shaders::",)),
     ("textures", ("radiant_textures::",)),
@@ -666,6 +667,7 @@ CATEGORIES = [
 def cmd_profile(args):
     """perf profile of each scene on one thread, by category and symbol."""
     scenes = selected(args)
+    rows = []
     for name in scenes:
         yaml = (os.path.join(ROOT, "scenes", "cornell-box.yaml") if name == "cornell-box"
                 else os.path.join(BENCH, f"{name}.yaml"))
@@ -696,6 +698,14 @@ def cmd_profile(args):
             print(f"| {cat} | {share:.1f} % |")
         print("\ntop symbols: " + "; ".join(f"{s:.1f} % {sym[:70]}"
                                              for s, _, sym in symbols[:args.top]))
+        rows.append((name, totals))
+    columns = [c for c, _ in CATEGORIES] + ["other"]
+    print("\n| scene | traversal | " + " | ".join(columns) + " |")
+    print("|---" * (len(columns) + 2) + "|")
+    for name, totals in rows:
+        trav = sum(v for k, v in totals.items() if k.startswith("traversal"))
+        cells = [f"{totals.get(c, 0.0):.1f} %" for c in columns]
+        print(f"| {name} | {trav:.1f} % | " + " | ".join(cells) + " |")
     return 0
 
 

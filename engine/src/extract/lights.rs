@@ -153,15 +153,22 @@ impl LightTable {
                 None => (first as usize, 0.0),
             };
         }
-        let total = self.total_importance(p);
+        // Each importance once; the sum in the order `total_importance` takes.
+        let mut weights = [0.0f32; FLAT_LIMIT];
+        let mut total = 0.0f32;
+        for ((_, b), w) in self.bounded.iter().zip(&mut weights) {
+            *w = b.importance(p);
+            if *w > 0.0 {
+                total += *w;
+            }
+        }
         if total <= 0.0 {
             return (first as usize, 0.0);
         }
         let target = (u - self.p_unbounded) / share * total;
         let mut acc = 0.0f32;
         let mut last = (first as usize, 0.0f32);
-        for (i, b) in &self.bounded {
-            let w = b.importance(p);
+        for ((i, _), &w) in self.bounded.iter().zip(&weights) {
             if w <= 0.0 {
                 continue;
             }
