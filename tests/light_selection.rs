@@ -114,6 +114,23 @@ fn check_table(table: &LightTable, p: Vec3, seed: u64) {
             "at {p}: probabilities sum to {sum}"
         );
     }
+    if n <= FLAT_LIMIT && table.lights().iter().all(|l| l.bounds().is_some()) {
+        // Exactly in proportion to the importance the lights claim.
+        let importance: Vec<f64> = table
+            .lights()
+            .iter()
+            .map(|l| f64::from(l.bounds().map_or(0.0, |b| b.importance(p))))
+            .collect();
+        let total: f64 = importance.iter().sum();
+        for (i, w) in importance.iter().enumerate() {
+            let expected = if total > 0.0 { w / total } else { 0.0 };
+            let got = f64::from(table.pmf_at(p, i));
+            assert!(
+                (got - expected).abs() <= 1e-6 * expected.max(1e-3),
+                "at {p}: light {i} has probability {got}, its importance share is {expected}"
+            );
+        }
+    }
     let draws = 200_000;
     let mut rng = Rng::new(seed);
     let mut observed = vec![0.0f64; n];
