@@ -1,14 +1,14 @@
 //! Heterogeneous media: height fog and grid media. The closed forms of
 //! height fog and the tracking estimators of grid media against exact
 //! values (chi-square of distances, unbiased transmittance), grid media in
-//! a furnace and at their limits, two scenes against Mitsuba 3 `volpath`
-//! (a spot light's beam in fog; a grid cloud under a sun and a sky), and
+//! a furnace and at their limits, three scenes against Mitsuba 3 `volpath`
+//! (a spot light's beam in fog; a grid cloud under a sun and a sky;
+//! random-walk subsurface scattering in a dielectric sphere), and
 //! bad grid files.
 //!
-//! References: `tests/data/media-beam-mitsuba.exr` and
-//! `tests/data/media-cloud-mitsuba.exr`, Mitsuba 3.9.1 (`scalar_rgb`,
-//! `volpath`) rendering `scenes/media/fog-beam.yaml` and
-//! `scenes/media/cloud.yaml`; regenerate them with
+//! References: `tests/data/media-{beam,cloud,jade}-mitsuba.exr`, Mitsuba
+//! 3.9.1 (`scalar_rgb`, `volpath`) rendering `scenes/media/fog-beam.yaml`,
+//! `scenes/media/cloud.yaml` and `scenes/media/jade.yaml`; regenerate them with
 //! `tests/reference/render_media.py` (its docstring has the commands).
 
 use glam::Vec3;
@@ -492,6 +492,21 @@ fn grid_cloud_matches_mitsuba_volpath_and_a_2_percent_sigma_s_error_fails() {
             "a 2 % σs error went unnoticed: {check:?}"
         );
     }
+}
+
+#[test]
+fn random_walk_subsurface_scattering_matches_mitsuba_volpath() {
+    // Subsurface scattering as a random walk: a dielectric sphere around a
+    // dense medium (scenes/media/jade.yaml). Every order of scattering
+    // inside, refraction in and out, internal reflection, MIS of the
+    // light's hits after the walk leaves the sphere.
+    let image = render_at("scenes/media/jade.yaml", str::to_string, SPP);
+    let check = check_against(&image, &reference("media-jade-mitsuba.exr"), BLOCK);
+    eprintln!("jade: {check:?}");
+    assert!(
+        check.worst_channel_mean_error < CHANNEL_MEAN_TOLERANCE && check.worst_block_error < 0.05,
+        "{check:?}"
+    );
 }
 
 // --- Bad input ---------------------------------------------------------------

@@ -32,9 +32,15 @@ The committed reference ``tests/data/media-smoke-mitsuba.exr`` was made with
     nice -n 10 python3 tests/reference/render_media.py --scene dark \\
         --spp 65536 --pass-spp 8192 --out tests/data/media-dark-mitsuba.exr
     nice -n 10 python3 tests/reference/render_media.py --scene beam \\
-        --spp 16384 --pass-spp 2048 --out tests/data/media-beam-mitsuba.exr
+        --spp 8192 --pass-spp 1024 --out tests/data/media-beam-mitsuba.exr
     nice -n 10 python3 tests/reference/render_media.py --scene cloud --write-grid \\
         --spp 8192 --pass-spp 1024 --out tests/data/media-cloud-mitsuba.exr
+    nice -n 10 python3 tests/reference/render_media.py --scene jade \\
+        --spp 4096 --pass-spp 512 --out tests/data/media-jade-mitsuba.exr
+
+``--scene jade``: ``scenes/media/jade.yaml``, random-walk subsurface
+scattering: a dielectric sphere around a dense scattering medium, under a
+constant sky and a spherical light.
 """
 import argparse
 import os
@@ -218,9 +224,43 @@ def cloud_scene(mi):
     })
 
 
+def jade_scene(mi):
+    """scenes/media/jade.yaml: random-walk subsurface scattering in a
+    dielectric sphere."""
+    T = mi.ScalarTransform4f
+    sigma_s, sigma_a = [6.0, 9.0, 7.0], [0.6, 0.1, 0.4]
+    sigma_t = [s + a for s, a in zip(sigma_s, sigma_a)]
+    top = max(sigma_t)
+    return mi.load_dict({
+        "type": "scene",
+        "integrator": {"type": "volpath", "max_depth": -1, "rr_depth": 5},
+        "sensor": {
+            "type": "perspective",
+            "fov": 30,
+            "to_world": T().look_at(origin=[0, 0.5, 3], target=[0, 0, 0], up=[0, 1, 0]),
+            "film": {"type": "hdrfilm", "width": SIZE, "height": SIZE,
+                     "rfilter": {"type": "gaussian", "stddev": 0.5}},
+        },
+        "jade": {
+            "type": "sphere", "radius": 0.6,
+            "bsdf": {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0},
+            "interior": {
+                "type": "homogeneous",
+                "sigma_t": {"type": "rgb", "value": [t / top for t in sigma_t]},
+                "scale": top,
+                "albedo": {"type": "rgb", "value": [s / t for s, t in zip(sigma_s, sigma_t)]},
+                "phase": {"type": "hg", "g": 0.2},
+            },
+        },
+        "light": {"type": "sphere", "center": [1.5, 1.8, 1.0], "radius": 0.5,
+                  "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [6, 6, 6]}}},
+        "sky": {"type": "constant", "radiance": {"type": "rgb", "value": [0.3, 0.35, 0.45]}},
+    })
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--scene", choices=["smoke", "dark", "beam", "cloud"], default="smoke")
+    ap.add_argument("--scene", choices=["smoke", "dark", "beam", "cloud", "jade"], default="smoke")
     ap.add_argument("--write-grid", action="store_true",
                     help="write scenes/media/cloud.vol from the procedural density first")
     ap.add_argument("--variant", default="scalar_rgb")
@@ -237,7 +277,8 @@ def main():
     t0 = time.time()
     if args.write_grid:
         write_cloud(np)
-    scenes = {"smoke": smoke_scene, "dark": dark_scene, "beam": beam_scene, "cloud": cloud_scene}
+    scenes = {"smoke": smoke_scene, "dark": dark_scene, "beam": beam_scene, "cloud": cloud_scene,
+              "jade": jade_scene}
     scene = scenes[args.scene](mi)
     accum = np.zeros((SIZE, SIZE, 3), dtype=np.float64)
     done = 0
