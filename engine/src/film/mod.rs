@@ -102,6 +102,26 @@ impl FilterTable {
     fn factor(&self, factor: &[f32], d: f32) -> f32 {
         self.index(d).map_or(0.0, |i| factor[i])
     }
+
+    /// The fast path of a splat at `pos` whose footprint's columns start
+    /// at `px0` and number `taps`: for a separable filter and at most
+    /// [`MAX_TAPS`] columns, fills `wx` with g of each column and returns g
+    /// (a row's weights are then g(row) times them); `None` where the
+    /// general path applies. [`TileFilm`] and [`aov::AovTile`] share it.
+    #[inline(always)]
+    fn separable_row(
+        &self,
+        pos_x: f32,
+        px0: i32,
+        taps: usize,
+        wx: &mut [f32; MAX_TAPS],
+    ) -> Option<&[f32]> {
+        let g = self.separable.as_deref().filter(|_| taps <= MAX_TAPS)?;
+        for (x, w) in (px0..).zip(&mut wx[..taps]) {
+            *w = self.factor(g, x as f32 + 0.5 - pos_x);
+        }
+        Some(g)
+    }
 }
 
 /// If the table is the outer product g(x)·g(y) of one function with itself
@@ -238,12 +258,9 @@ impl TileFilm {
         let (px0, px1, py0, py1) = self.bounds.footprint(pos, table.radius);
         let v = value.extend(1.0);
         let taps = (px1 - px0 + 1).max(0) as usize;
-        if let (Some(g), true) = (&table.separable, taps <= MAX_TAPS) {
-            // One row of weights, reused on every row of pixels.
-            let mut wx = [0.0f32; MAX_TAPS];
-            for (x, w) in (px0..).zip(&mut wx[..taps]) {
-                *w = table.factor(g, x as f32 + 0.5 - pos.x);
-            }
+        // One row of weights, reused on every row of pixels.
+        let mut wx = [0.0f32; MAX_TAPS];
+        if let Some(g) = table.separable_row(pos.x, px0, taps, &mut wx) {
             let mut start = self.bounds.index(px0, py0);
             for y in py0..=py1 {
                 let vy = v * table.factor(g, y as f32 + 0.5 - pos.y);
