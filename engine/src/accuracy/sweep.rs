@@ -14,6 +14,8 @@ use super::twin::{TwinImages, TwinRender};
 use crate::accel::BuildQuality;
 use crate::extract::{Overrides, RenderScene, extract};
 use crate::film::denoise::Denoiser;
+use crate::integrators::Integrator;
+use crate::integrators::adaptive::Adaptive;
 use crate::scene::{FilterSampling, LightSelection, Scene, default_module};
 use crate::world::{EmitterSpec, LightSpec};
 use radiant_core::{Filter, Registry, Sampler};
@@ -46,11 +48,17 @@ pub enum Axis {
     /// Open Image Denoise on each half (off, on; where the library
     /// loads): what denoising buys at each time, and where it biases.
     Denoise,
+    /// Every registered integrator, with its default parameters (and the
+    /// scene's `max_depth`, `rr_depth`, `light_selection`).
+    Integrator,
+    /// Adaptive sampling (on with the default rule, or off where the scene
+    /// turns it on): what stopping converged pixels saves.
+    Adaptive,
 }
 
 impl Axis {
     /// Every axis, in report order.
-    pub const ALL: [Axis; 10] = [
+    pub const ALL: [Axis; 12] = [
         Axis::Spp,
         Axis::MaxDepth,
         Axis::RrDepth,
@@ -61,6 +69,8 @@ impl Axis {
         Axis::Bvh,
         Axis::Backend,
         Axis::Denoise,
+        Axis::Integrator,
+        Axis::Adaptive,
     ];
 
     /// The name used on the command line and in the CSV.
@@ -76,6 +86,8 @@ impl Axis {
             Axis::Bvh => "bvh",
             Axis::Backend => "backend",
             Axis::Denoise => "denoise",
+            Axis::Integrator => "integrator",
+            Axis::Adaptive => "adaptive",
         }
     }
 
@@ -115,6 +127,10 @@ pub enum Change {
     /// Denoised (with `filter_sampling: importance`, as `--denoise`
     /// renders).
     Denoise,
+    /// The integrator type (default parameters).
+    Integrator(String),
+    /// Adaptive sampling on (the default rule) or off.
+    Adaptive(bool),
 }
 
 /// One setting of the sweep.
@@ -141,7 +157,7 @@ impl Setting {
             Change::Baseline => "scene".into(),
             Change::MaxDepth(d) => d.to_string(),
             Change::RrDepth(d) => d.to_string(),
-            Change::Filter(t) | Change::Sampler(t) => t.clone(),
+            Change::Filter(t) | Change::Sampler(t) | Change::Integrator(t) => t.clone(),
             Change::FilterSampling(FilterSampling::Splat) => "splat".into(),
             Change::FilterSampling(FilterSampling::Importance) => "importance".into(),
             Change::LightSelection(LightSelection::Power) => "power".into(),
@@ -149,7 +165,8 @@ impl Setting {
             Change::LightSelection(LightSelection::Spatial) => "spatial".into(),
             Change::Bvh(q) => format!("{q:?}").to_lowercase(),
             Change::Gpu => "gpu".into(),
-            Change::Denoise => "on".into(),
+            Change::Denoise | Change::Adaptive(true) => "on".into(),
+            Change::Adaptive(false) => "off".into(),
         }
     }
 
@@ -179,14 +196,19 @@ impl Setting {
             _ => {}
         }
         let (filter, sampler) = (scene.filter.clone(), scene.sampler.clone());
+        let (integrator, adaptive) = (scene.integrator.clone(), scene.settings.adaptive);
         match &self.change {
             Change::Filter(t) => scene.filter = default_module(t),
             Change::Sampler(t) => scene.sampler = default_module(t),
+            Change::Integrator(t) => scene.integrator = default_module(t),
+            Change::Adaptive(on) => scene.settings.adaptive = on.then(Adaptive::default),
             _ => {}
         }
         let render = extract(scene, registry, &overrides);
         scene.filter = filter;
         scene.sampler = sampler;
+        scene.integrator = integrator;
+        scene.settings.adaptive = adaptive;
         Ok(render?)
     }
 }
@@ -198,6 +220,9 @@ pub fn settings(scene: &Scene, registry: &Registry, axes: &[Axis]) -> (Vec<Setti
     let mut list = vec![Setting::baseline()];
     let mut notes = Vec::new();
     let s = &scene.settings;
+    // The GPU and the denoiser's planes need `path` rendered in passes.
+    let plain =
+        scene.integrator.type_name == crate::integrators::module::DEFAULT && s.adaptive.is_none();
     for &axis in axes {
         let changes: Vec<Change> = match axis {
             Axis::Spp => continue,
@@ -251,6 +276,18 @@ pub fn settings(scene: &Scene, registry: &Registry, axes: &[Axis]) -> (Vec<Setti
                 .into_iter()
                 .map(Change::Bvh)
                 .collect(),
+            Axis::Backend | Axis::Denoise if !plain => {
+                notes.push(format!(
+                    "{axis}: not measured: the scene's integrator `{}`{} does not render in passes",
+                    scene.integrator.type_name,
+                    if s.adaptive.is_some() {
+                        " with adaptive sampling"
+                    } else {
+                        ""
+                    }
+                ));
+                continue;
+            }
             Axis::Backend => match super::shared_gpu() {
                 Ok(_) => vec![Change::Gpu],
                 Err(why) => {
@@ -265,6 +302,13 @@ pub fn settings(scene: &Scene, registry: &Registry, axes: &[Axis]) -> (Vec<Setti
                     continue;
                 }
             },
+            Axis::Integrator => registry
+                .names::<dyn Integrator>()
+                .into_iter()
+                .filter(|t| *t != scene.integrator.type_name)
+                .map(|t| Change::Integrator(t.to_string()))
+                .collect(),
+            Axis::Adaptive => vec![Change::Adaptive(s.adaptive.is_none())],
         };
         if changes.is_empty() {
             notes.push(format!("{axis}: only the scene's own value is registered"));
@@ -357,6 +401,7 @@ pub fn measure(
     let mut twin = TwinRender::new(scene, registry, render, limits.seed + 1)?
         .on_gpu(gpu)
         .denoised_by(denoiser)?;
+    twin.whole_renders_where_needed();
     let mut points = Vec::new();
     twin.run_doubling(max_half, start, limits.share, |twin| {
         let images = TwinImages::of(twin);
@@ -369,7 +414,7 @@ pub fn measure(
         });
     });
     if let Some(e) = twin.take_error() {
-        return Err(e.into());
+        return Err(e);
     }
     Ok(Curve {
         setting: setting.clone(),
@@ -419,7 +464,30 @@ mod tests {
         let mut registry = crate::builtin_registry();
         let one = scene("{type: path, max_depth: 5, rr_depth: 2}", POINT);
         let (list, notes) = settings(&one, &registry, &Axis::ALL);
-        let mut labels: Vec<String> = list.iter().map(Setting::label).collect();
+        // The integrator axis holds every registered integrator but the
+        // scene's, and the adaptive axis turns adaptive sampling on.
+        let integrators: Vec<String> = list
+            .iter()
+            .filter(|s| s.axis == Axis::Integrator)
+            .map(Setting::value)
+            .collect();
+        let others: Vec<&str> = registry
+            .names::<dyn Integrator>()
+            .into_iter()
+            .filter(|t| *t != "path")
+            .collect();
+        assert_eq!(integrators, others);
+        let adaptive: Vec<String> = list
+            .iter()
+            .filter(|s| s.axis == Axis::Adaptive)
+            .map(Setting::label)
+            .collect();
+        assert_eq!(adaptive, ["adaptive=on"]);
+        let mut labels: Vec<String> = list
+            .iter()
+            .filter(|s| !matches!(s.axis, Axis::Integrator | Axis::Adaptive))
+            .map(Setting::label)
+            .collect();
         // The denoise axis is there where the library loads, else a note.
         let denoise = labels.last().is_some_and(|l| l == "denoise=on");
         assert_eq!(denoise, shared_denoiser().is_ok());

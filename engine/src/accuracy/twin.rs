@@ -2,10 +2,14 @@
 //! seeds, over one extracted scene: the halves whose difference measures
 //! the noise (see [`metrics`](super::metrics)). On the `denoise` axis each
 //! half also collects its first-hit planes and is denoised when developed.
+//! An integrator or adaptive sampling that does not render in passes
+//! ([`cpu::passes`](crate::backend::cpu::passes)) is measured by whole
+//! renders instead: each point renders both halves afresh with all its
+//! samples, and its time is that render's.
 
 use super::metrics::Halves;
-use crate::backend::cpu::{Progress, render_samples, render_samples_with_aovs};
-use crate::backend::gpu::{GpuBackend, GpuError};
+use crate::backend::cpu::{self, Progress, render_samples, render_samples_with_aovs};
+use crate::backend::gpu::GpuBackend;
 use crate::error::{SceneError, module_error};
 use crate::extract::RenderScene;
 use crate::film::aov::AovFilm;
@@ -30,12 +34,26 @@ pub struct TwinRender {
     time: Duration,
     /// The GPU that renders instead of the CPU (the `backend` axis).
     gpu: Option<&'static Mutex<GpuBackend>>,
-    /// The GPU's first failure; rendering stops there.
-    error: Option<GpuError>,
+    /// The first failure (the GPU's, or a whole render's memory);
+    /// rendering stops there.
+    error: Option<super::AccuracyError>,
+    /// Whole renders' images and seeds, where the scene does not render in
+    /// passes.
+    whole: Option<Whole>,
+    /// The seeds of the two halves.
+    seeds: [u64; 2],
     /// The denoiser of the `denoise` axis, with each half's planes.
     denoise: Option<(&'static Denoiser, [AovFilm; 2])>,
     /// Time spent denoising so far (developing happens behind `&self`).
     denoise_time: Cell<Duration>,
+}
+
+/// The halves of whole renders: their latest images, seeds and invalid
+/// samples.
+struct Whole {
+    images: [Image; 2],
+    seeds: [u64; 2],
+    invalid: u64,
 }
 
 /// Builds `scene`'s sampler for `seed` the way extract does (samplers use
@@ -68,6 +86,7 @@ impl TwinRender {
         second_seed: u64,
     ) -> Result<Self, super::AccuracyError> {
         let other = build_sampler(scene, registry, &render, second_seed)?;
+        let first_seed = render.settings.seed;
         let (w, h) = (render.settings.width, render.settings.height);
         let whole = |e| super::AccuracyError::WholeFilm(Box::new(e));
         Ok(Self {
@@ -81,6 +100,8 @@ impl TwinRender {
             time: Duration::ZERO,
             gpu: None,
             error: None,
+            whole: None,
+            seeds: [first_seed, second_seed],
             denoise: None,
             denoise_time: Cell::new(Duration::ZERO),
         })
@@ -112,9 +133,54 @@ impl TwinRender {
         Self { gpu, ..self }
     }
 
-    /// The GPU's failure, if rendering stopped on one.
-    pub fn take_error(&mut self) -> Option<GpuError> {
+    /// The failure, if rendering stopped on one.
+    pub fn take_error(&mut self) -> Option<super::AccuracyError> {
         self.error.take()
+    }
+
+    /// Measures by whole renders where the scene does not render in
+    /// passes (see the module documentation).
+    pub fn whole_renders_where_needed(&mut self) {
+        if cpu::passes(&self.scene).is_err() {
+            let (w, h) = (self.scene.settings.width, self.scene.settings.height);
+            let black = || Image {
+                width: w,
+                height: h,
+                pixels: vec![radiant_core::Rgb::ZERO; w as usize * h as usize],
+            };
+            self.whole = Some(Whole {
+                images: [black(), black()],
+                seeds: self.seeds,
+                invalid: 0,
+            });
+        }
+    }
+
+    /// Renders both halves afresh with `spp` samples per pixel each, as
+    /// whole renders; returns the time this took.
+    fn render_whole(&mut self, spp: u32) -> Duration {
+        let Some(whole) = &mut self.whole else {
+            return Duration::ZERO;
+        };
+        let mut took = Duration::ZERO;
+        whole.invalid = 0;
+        for half in 0..2 {
+            self.scene.settings.spp = spp;
+            self.scene.settings.seed = whole.seeds[half];
+            match cpu::try_render(&self.scene, &Progress::none()) {
+                Ok(r) => {
+                    took += r.time;
+                    whole.invalid += r.invalid_samples;
+                    whole.images[half] = r.image;
+                }
+                Err(e) => {
+                    self.error
+                        .get_or_insert(super::AccuracyError::WholeFilm(Box::new(e)));
+                }
+            }
+            std::mem::swap(&mut self.scene.sampler, &mut self.other);
+        }
+        took
     }
 
     /// Samples per pixel rendered so far in each half.
@@ -130,6 +196,13 @@ impl TwinRender {
     /// Renders both halves on to `spp` samples per pixel each; returns the
     /// time this took.
     pub fn advance(&mut self, spp: u32) -> Duration {
+        if self.whole.is_some() {
+            // A whole render's time is its own, not added to the last.
+            let took = self.render_whole(spp);
+            self.spp = spp;
+            self.time = took;
+            return took;
+        }
         let mut took = Duration::ZERO;
         if spp > self.spp && self.error.is_none() {
             for (half, film) in self.films.iter_mut().enumerate() {
@@ -146,7 +219,7 @@ impl TwinRender {
                         match gpu.render_samples(&self.scene, film, range, &none) {
                             Ok(pass) => pass.time,
                             Err(e) => {
-                                self.error.get_or_insert(e);
+                                self.error.get_or_insert(e.into());
                                 Duration::ZERO
                             }
                         }
@@ -177,8 +250,11 @@ impl TwinRender {
         let max_half = max_half.max(1);
         let mut spp = 1;
         let mut done = 0;
+        let whole = self.whole.is_some();
         loop {
-            let per_sample = self.advance(spp).as_secs_f64() / (spp - done) as f64;
+            // Whole renders render all their samples again.
+            let rendered = if whole { spp } else { spp - done };
+            let per_sample = self.advance(spp).as_secs_f64() / rendered as f64;
             if self.error.is_some() {
                 break;
             }
@@ -192,6 +268,7 @@ impl TwinRender {
             } else {
                 u32::MAX
             };
+            let fit = if whole { fit.saturating_sub(spp) } else { fit };
             let more = spp.min(max_half - spp).min(fit);
             if more == 0 || more < spp / 4 {
                 break;
@@ -204,6 +281,9 @@ impl TwinRender {
     /// The two halves developed (and denoised, on the `denoise` axis;
     /// a half the denoiser fails on stays as it is).
     pub fn images(&self) -> [Image; 2] {
+        if let Some(whole) = &self.whole {
+            return whole.images.clone();
+        }
         let images = [self.films[0].develop(), self.films[1].develop()];
         let Some((denoiser, planes)) = &self.denoise else {
             return images;
@@ -223,7 +303,8 @@ impl TwinRender {
 
     /// Samples that were NaN or infinite (recorded as black), both halves.
     pub fn invalid_samples(&self) -> u64 {
-        self.films.iter().map(|f| f.invalid_samples).sum()
+        self.films.iter().map(|f| f.invalid_samples).sum::<u64>()
+            + self.whole.as_ref().map_or(0, |w| w.invalid)
     }
 }
 

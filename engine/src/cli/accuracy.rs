@@ -33,7 +33,9 @@ pub struct AccuracyArgs {
     /// Sweep only these axes, comma-separated: spp, max_depth, rr_depth,
     /// filter, filter_sampling, sampler, light_selection, bvh, backend (the
     /// GPU, where a hardware adapter is present), denoise (Open Image
-    /// Denoise, where it loads); the scene as written is always measured.
+    /// Denoise, where it loads), integrator (every registered integrator),
+    /// adaptive (adaptive sampling on or off); the scene as written is
+    /// always measured.
     #[arg(long, value_delimiter = ',')]
     only: Vec<String>,
     /// Largest samples per pixel of a setting.
