@@ -144,6 +144,49 @@ fn height_fog_glows_as_its_closed_form() {
     }
 }
 
+#[test]
+fn torture_height_fog_at_extreme_heights_is_finite() {
+    // A fog layer of scale height 1e-3 under a uniform sky of radiance 1.
+    // Camera 1 unit below the reference height, looking up: the density
+    // there is e^1000 times the reference, clamped to e^80 (finite); the
+    // fog (albedo 0.5) is optically infinitely thick: finite, the render
+    // ends, and no light gets through (every pixel below 1e-3).
+    // Camera 1 unit above it: density e^(−80) and less, vacuum: every
+    // pixel is the sky's 1 (within 1e-3).
+    let scene = |camera_y: f32| {
+        format!(
+            "integrator: {{type: path, max_depth: -1}}\n\
+             film: {{width: 8, height: 8, filter: {{type: box}}}}\n\
+             sampler: {{type: independent, spp: 16}}\n\
+             camera: {{type: perspective, fov: 60, look_at: {{origin: [0, {camera_y}, 0], target: [0, {}, 0.3], up: [0, 0, 1]}}}}\n\
+             media:\n  fog: {{type: height_fog, albedo: 0.5, density: 1, height: 0, scale_height: 1e-3}}\n\
+             atmosphere: fog\n\
+             lights:\n  - {{type: environment, radiance: 1}}\n",
+            camera_y + 1.0
+        )
+    };
+    let below = render_text(&scene(-1.0));
+    assert_eq!(below.invalid_samples, 0);
+    let worst = below
+        .image
+        .pixels
+        .iter()
+        .map(|p| p.max_element())
+        .fold(0.0f32, f32::max);
+    assert!(
+        worst < 1e-3,
+        "light got through the infinitely thick fog: {worst}"
+    );
+    let above = render_text(&scene(1.0));
+    assert_eq!(above.invalid_samples, 0);
+    for p in &above.image.pixels {
+        assert!(
+            (*p - Rgb::ONE).abs().max_element() < 1e-3,
+            "above the fog: {p}"
+        );
+    }
+}
+
 // --- Grid media: tracking against closed forms -------------------------------
 
 /// A grid of `n`³ voxels of `value` over [−1, 1]³.
