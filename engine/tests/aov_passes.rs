@@ -6,6 +6,9 @@
 // `unwrap`/`expect` in this test code is the assertion: the inputs are the
 // test's own, so a failure is a bug, and the panic reports it.
 
+#[allow(dead_code)]
+mod common;
+
 use exr::prelude::{FlatSamples, ReadChannels, ReadLayers};
 use std::collections::HashMap;
 use std::path::Path;
@@ -269,4 +272,63 @@ fn the_scene_asks_for_layers_with_film_aovs() {
         "a.exr",
         "film aovs must be a list of output variable names",
     );
+}
+
+/// Ctrl-C stops a render with passes after the pass in progress and
+/// writes the image and its layers of the samples so far (exit status
+/// 130): every pixel's `spp.Y` is the count it reports, and the beauty is
+/// a render of that many samples, bit for bit.
+#[test]
+fn an_interrupted_render_with_passes_keeps_its_samples() {
+    use std::process::{Command, Stdio};
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("square.yaml");
+    std::fs::write(&scene, SCENE).unwrap();
+    let out = dir.path().join("passes.exr");
+    let spp = "100000000";
+    let child = Command::new(env!("CARGO_BIN_EXE_radiant"))
+        .args(["render", arg(&scene), "-o", arg(&out), "--threads", "2"])
+        .args(["--aov", "albedo,spp", "--spp", spp])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    common::wait_for_sigint_handler(child.id());
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let o = child.wait_with_output().unwrap();
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(130), "{e}");
+    let ch = channels(&out);
+    let held = ch["spp.Y"][0];
+    assert!((1.0..1e8).contains(&held), "{held}");
+    assert!(ch["spp.Y"].iter().all(|&n| n == held));
+    let held = (held as u32).to_string();
+    assert!(
+        e.contains(&format!(
+            "interrupted: {held} of {spp} spp written to {}",
+            out.display()
+        )),
+        "{e}"
+    );
+    assert!(ch.contains_key("albedo.R"));
+    let plain = dir.path().join("plain.exr");
+    let o = radiant(&[
+        "render",
+        arg(&scene),
+        "-o",
+        arg(&plain),
+        "--threads",
+        "2",
+        "--spp",
+        &held,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let plain = channels(&plain);
+    for c in ["R", "G", "B"] {
+        assert!(plain[c] == ch[c], "channel {c}");
+    }
 }

@@ -14,7 +14,7 @@
 #[allow(dead_code)]
 mod common;
 
-use common::{arg, radiant, read, shot, stderr};
+use common::{arg, radiant, read, shot, stderr, wait_for_sigint_handler};
 use radiant::farm::partial;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
@@ -176,25 +176,6 @@ fn an_interrupted_render_resumes_into_the_uninterrupted_image() {
     let (resumed, single) = (read(&out), read(&single));
     assert!(resumed == single, "resumed image differs from one render");
     assert!(single.mean() > 0.0);
-}
-
-/// Waits until process `pid` handles SIGINT (bit 1 of the `SigCgt` mask
-/// in its /proc status), for at most 120 s.
-fn wait_for_sigint_handler(pid: u32) {
-    let deadline = Instant::now() + Duration::from_secs(120);
-    loop {
-        let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
-        let caught = status
-            .lines()
-            .find_map(|l| l.strip_prefix("SigCgt:"))
-            .map(|mask| u64::from_str_radix(mask.trim(), 16).unwrap())
-            .unwrap();
-        if caught & 2 != 0 {
-            return;
-        }
-        assert!(Instant::now() < deadline, "SIGINT not handled in 120 s");
-        std::thread::sleep(Duration::from_millis(20));
-    }
 }
 
 #[test]

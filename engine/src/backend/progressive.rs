@@ -16,10 +16,12 @@
 //! Passes hold whole blocks of samples ([`BLOCK`]), so that the film's
 //! exact sums do not depend on where passes (or runs) start.
 
+use super::cpu::Pass;
 use super::{Backend, Progress, RenderError};
 use crate::extract::RenderScene;
 use crate::film::Film;
 use crate::film::exact::BLOCK;
+use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
@@ -122,6 +124,26 @@ pub fn render<E: From<RenderError>>(
     controls: &Controls<'_>,
     checkpoint: &mut dyn FnMut(&Film, u32) -> Result<(), E>,
 ) -> Result<Outcome, E> {
+    let mut pass = |film: &mut Film, samples: Range<u32>, progress: &Progress<'_>| {
+        backend.render_samples(scene, film, samples, progress)
+    };
+    render_passes(&mut pass, film, done, controls, checkpoint)
+}
+
+/// Renders a pass of samples into a film: the backend's passes, or the CPU
+/// backend's with first-hit planes beside the film.
+pub type PassFn<'a> =
+    dyn FnMut(&mut Film, Range<u32>, &Progress<'_>) -> Result<Pass, RenderError> + 'a;
+
+/// [`render`] with the passes rendered by `pass` (which adds the samples
+/// of a range to the film, and to whatever else it keeps).
+pub fn render_passes<E: From<RenderError>>(
+    pass: &mut PassFn<'_>,
+    film: &mut Film,
+    done: u32,
+    controls: &Controls<'_>,
+    checkpoint: &mut dyn FnMut(&Film, u32) -> Result<(), E>,
+) -> Result<Outcome, E> {
     let (limits, progress) = (&controls.limits, controls.progress);
     let start = Instant::now();
     let pixels = u64::from(film.width()) * u64::from(film.height());
@@ -158,7 +180,7 @@ pub fn render<E: From<RenderError>>(
             Progress::none()
         };
         let range = outcome.samples..outcome.samples + count;
-        let pass = backend.render_samples(scene, film, range, &pass_progress)?;
+        let pass = pass(film, range, &pass_progress)?;
         outcome.samples += count;
         outcome.passes += 1;
         outcome.time += pass.time;

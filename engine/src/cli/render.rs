@@ -329,7 +329,8 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
                 session.render(args, backend.as_mut(), (s, frame), &path, &progress, &note)
             } else if planes {
                 let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
-                passes::write(&args.passes, s, &path, &progress, &note)
+                let interrupt = progressive.as_ref().map(|p| p.interrupt()).transpose()?;
+                passes::write(&args.passes, s, &path, &progress, &note, interrupt)
             } else {
                 backend
                     .write(s, &path, &progress)

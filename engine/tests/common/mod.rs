@@ -7,6 +7,7 @@
 use radiant::film::Image;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::time::{Duration, Instant};
 
 /// A small animated room: a tumbling cube, a light that brightens and a
 /// camera that moves over frames 1..12.
@@ -143,4 +144,24 @@ pub fn difference(a: &Image, b: &Image) -> (f32, usize) {
         .filter(|(p, q)| p.to_array().map(f32::to_bits) == q.to_array().map(f32::to_bits))
         .count();
     (largest / peak, same)
+}
+
+/// Waits until process `pid` handles SIGINT (bit 1 of the `SigCgt` mask
+/// in its /proc status), for at most 120 s.
+#[allow(dead_code)] // The Ctrl-C tests' alone, not every test binary's.
+pub fn wait_for_sigint_handler(pid: u32) {
+    let deadline = Instant::now() + Duration::from_secs(120);
+    loop {
+        let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
+        let caught = status
+            .lines()
+            .find_map(|l| l.strip_prefix("SigCgt:"))
+            .map(|mask| u64::from_str_radix(mask.trim(), 16).unwrap())
+            .unwrap();
+        if caught & 2 != 0 {
+            return;
+        }
+        assert!(Instant::now() < deadline, "SIGINT not handled in 120 s");
+        std::thread::sleep(Duration::from_millis(20));
+    }
 }

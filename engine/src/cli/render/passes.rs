@@ -6,14 +6,18 @@
 
 use super::RenderArgs;
 use clap::Args;
-use radiant::backend::{BackendKind, Progress, Written, cpu};
+use radiant::backend::progressive::{self, Controls, Limits, Stop};
+use radiant::backend::{BackendKind, Progress, RenderError, Written, cpu};
 use radiant::extract::{Overrides, RenderScene};
-use radiant::film::aov::{self, AovSet};
+use radiant::film::aov::{self, AovFilm, AovImage, AovSet};
 use radiant::film::denoise::{Denoiser, Guides};
+use radiant::film::{Film, Image};
 use radiant::film::{layers, output};
 use radiant::settings::FilterSampling;
 use radiant::settings::RenderSettings;
+use std::ops::Range;
 use std::path::Path;
+use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 /// The options of the planes and the denoiser.
@@ -113,14 +117,30 @@ fn is_exr(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
 }
 
+/// How Ctrl-C reaches a render with planes: the flag it raises, and
+/// whether the frame is one of a sequence's.
+pub(super) struct Interrupt<'a> {
+    /// Raised by Ctrl-C.
+    pub flag: &'a AtomicBool,
+    /// Whether the frame is one of a sequence's.
+    pub sequence: bool,
+}
+
 /// Renders `scene` with its planes on the CPU, denoises it where asked and
 /// writes `path` (atomically); says on stderr how long denoising took.
+/// Where `interrupt` is given and the integrator renders in passes, it
+/// renders in passes so that Ctrl-C stops it after the pass in progress:
+/// a single frame then writes the image and planes of its samples so far
+/// (there is no state for `--resume`: the planes are not kept in one), a
+/// frame of a sequence writes nothing (its file appears only when it is
+/// finished).
 pub(super) fn write(
     args: &PassArgs,
     scene: &RenderScene,
     path: &Path,
     progress: &Progress<'_>,
     note: &dyn Fn(&str),
+    interrupt: Option<Interrupt<'_>>,
 ) -> miette::Result<Written> {
     let aovs = scene.settings.output.aovs.list();
     // Loaded before rendering, so that a missing library costs no render.
@@ -129,14 +149,41 @@ pub(super) fn write(
         .then(Denoiser::load)
         .transpose()
         .map_err(|e| miette::miette!("{e}"))?;
-    let (rendered, planes) =
-        cpu::render_with_aovs(scene, progress).map_err(|e| miette::miette!("{e}"))?;
-    let written = Written::from(&rendered);
+    let in_passes = interrupt.filter(|_| cpu::passes(scene).is_ok());
+    let (image, planes, written, stopped) = match &in_passes {
+        Some(i) => render_in_passes(scene, progress, i.flag).map_err(|e| miette::miette!("{e}"))?,
+        None => {
+            let (rendered, planes) =
+                cpu::render_with_aovs(scene, progress).map_err(|e| miette::miette!("{e}"))?;
+            let written = Written::from(&rendered);
+            (rendered.image, planes, written, None)
+        }
+    };
+    let spp = scene.settings.spp;
+    match (stopped, &in_passes) {
+        (Some(0), _) => {
+            note("interrupted before the first pass ended: nothing written");
+            return Ok(written);
+        }
+        (Some(samples), Some(i)) if i.sequence => {
+            note(&format!(
+                "interrupted: {samples} of {spp} spp of this frame not written (a render with \
+                 passes keeps no state for --resume; its file appears only when it is finished)"
+            ));
+            return Ok(written);
+        }
+        (Some(samples), _) => note(&format!(
+            "interrupted: {samples} of {spp} spp written to {} (with its passes; they keep no \
+             state for --resume)",
+            path.display()
+        )),
+        (None, _) => {}
+    }
     let image = match &denoiser {
         Some(d) => {
             let start = Instant::now();
             let image = d
-                .denoise(&rendered.image, &planes, Guides::of(scene))
+                .denoise(&image, &planes, Guides::of(scene))
                 .map_err(|e| miette::miette!("{e}"))?;
             note(&format!(
                 "denoised in {:.2} s (Open Image Denoise from {})",
@@ -145,7 +192,7 @@ pub(super) fn write(
             ));
             image
         }
-        None => rendered.image,
+        None => image,
     };
     if aovs.is_empty() && scene.settings.output.alpha {
         radiant::film::alpha::write(path, &image, &planes.alpha, &scene.settings.output)
@@ -156,4 +203,47 @@ pub(super) fn write(
     }
     .map_err(|e| miette::miette!("{e}"))?;
     Ok(written)
+}
+
+/// Renders `scene` with its planes in passes until its spp are done or
+/// `interrupt` is raised: the image, the planes, what was rendered, and
+/// the samples per pixel held where it was interrupted.
+fn render_in_passes(
+    scene: &RenderScene,
+    progress: &Progress<'_>,
+    interrupt: &AtomicBool,
+) -> Result<(Image, AovImage, Written, Option<u32>), RenderError> {
+    let s = &scene.settings;
+    let mut film = Film::try_new(s.width, s.height)?;
+    let mut aovs = AovFilm::try_new(s.width, s.height)?;
+    let controls = Controls {
+        limits: Limits {
+            spp: s.spp,
+            time: None,
+            checkpoint: None,
+            pass_time: progressive::PASS_TIME,
+        },
+        interrupt,
+        progress,
+    };
+    let mut pass = |film: &mut Film, samples: Range<u32>, progress: &Progress<'_>| {
+        Ok(cpu::render_samples_with_aovs(
+            scene, film, &mut aovs, samples, progress,
+        ))
+    };
+    let outcome = progressive::render_passes::<RenderError>(
+        &mut pass,
+        &mut film,
+        0,
+        &controls,
+        &mut |_, _| Ok(()),
+    )?;
+    let written = Written {
+        time: outcome.time,
+        samples: u64::from(s.width) * u64::from(s.height) * u64::from(outcome.samples),
+        rays: outcome.rays,
+        invalid_samples: film.invalid_samples,
+    };
+    let stopped = (outcome.stop == Stop::Interrupted).then_some(outcome.samples);
+    Ok((film.try_develop()?, aovs.develop(), written, stopped))
 }

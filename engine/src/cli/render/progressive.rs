@@ -376,6 +376,16 @@ impl Session {
         Ok(written)
     }
 
+    /// Ctrl-C for a render with first-hit planes (`passes.rs`), handled
+    /// from now on.
+    pub(super) fn interrupt(&self) -> miette::Result<super::passes::Interrupt<'_>> {
+        self.handle_interrupts()?;
+        Ok(super::passes::Interrupt {
+            flag: &self.interrupt,
+            sequence: self.sequence,
+        })
+    }
+
     /// Whether Ctrl-C stopped the render.
     pub(super) fn interrupted(&self) -> bool {
         self.interrupt.load(Ordering::Relaxed)
