@@ -12,7 +12,8 @@
 //! * Factors times textures (base colour; metalness and roughness from the
 //!   blue and green channels of the metallic-roughness texture),
 //!   `KHR_texture_transform`, `TEXCOORD_1`, images embedded as `data:`
-//!   URIs and in a `.glb`'s binary chunk, orthographic cameras.
+//!   URIs and in a `.glb`'s binary chunk, samplers' wrap and filter,
+//!   orthographic cameras.
 //! * Light units: a glTF point or spot light of I candela and a
 //!   directional light of E lux light a grey diffuse plane as Radiant
 //!   lights of I W/sr and E W/m² do (radiance ρ/π · I/d² and ρ/π · E).
@@ -704,4 +705,36 @@ fn gltf_light_units_are_candela_and_lux_read_as_radiant_units() {
             );
         }
     }
+}
+
+/// A texture's sampler carries over: `CLAMP_TO_EDGE` as `wrap: clamp`,
+/// `NEAREST` magnification as `filter: nearest` (the texture is repeated
+/// three times by its transform, so the wrap mode shows).
+#[test]
+fn gltf_samplers_set_wrap_and_filter() {
+    let mut gltf = scene_json();
+    gltf["images"] = json!([{"uri": "colour.exr"}]);
+    gltf["samplers"] = json!([{"magFilter": 9728, "wrapS": 33071, "wrapT": 33071}]);
+    gltf["textures"] = json!([{"source": 0, "sampler": 0}]);
+    gltf["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] =
+        json!({"index": 0, "extensions": {"KHR_texture_transform": {"scale": [3.0, 3.0]}}});
+    let dir = gltf_folder(&gltf);
+    write_texture(&dir.path().join("colour.exr"), TEXELS, colour);
+    let twin = |sampling: &str| {
+        let textures = format!(
+            "{{plain: {{type: image, filename: colour.exr{sampling}}}, checks: {{type: uv_transform, \
+             texture: plain, scale: [3, 3]}}}}"
+        );
+        let material = "{type: principled, base_color: checks, metallic: 0.3, roughness: 0.6}";
+        render_text_in(dir.path(), &twin_yaml(&textures, material)).expect("the twin renders")
+    };
+    let gltf_image = render_text_in(dir.path(), GLTF_SCENE).expect("the glTF scene renders");
+    assert_twin(
+        &gltf_image,
+        &twin(", wrap: clamp, filter: nearest"),
+        &[
+            ("repeated", twin(", filter: nearest")),
+            ("bilinear", twin(", wrap: clamp")),
+        ],
+    );
 }
