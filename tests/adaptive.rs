@@ -166,3 +166,29 @@ fn bad_adaptive_keys_are_located_errors() {
         );
     }
 }
+
+#[test]
+fn a_gaussian_film_keeps_converged_pixels_their_value() {
+    // With splatting, a converged pixel's few samples were outweighed in
+    // its neighbours' sums by their many: the Cornell box's light (flat,
+    // so converged at once) came out dark and the image's mean 10 % low.
+    // Filter importance sampling keeps each pixel its own samples.
+    let overrides = Overrides {
+        width: Some(48),
+        height: Some(48),
+        ..Overrides::default()
+    };
+    let box_scene = "scenes/cornell-box.yaml";
+    let with = |spp: &'static str| {
+        move |text: &str| {
+            assert!(text.contains("  spp: 64\n"));
+            text.replace("  spp: 64\n", spp)
+        }
+    };
+    let fixed = radiant_tests::render_edited(box_scene, with("  spp: 256\n"), overrides);
+    let adaptive =
+        radiant_tests::render_edited(box_scene, with("  spp: 256\n  adaptive: true\n"), overrides);
+    let ratio = adaptive.image.mean() / fixed.image.mean();
+    assert!((ratio - 1.0).abs() < 0.02, "adaptive / fixed mean {ratio}");
+    assert!(adaptive.samples < fixed.samples, "the light stopped early");
+}
