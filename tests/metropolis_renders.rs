@@ -141,7 +141,7 @@ fn metropolis_integrators_converge_to_path_on_the_cornell_box() {
     let path_mean = interior_mean(&path);
     for integrator in [
         "pssmlt, bootstrap: 200000",
-        "erpt, seeds: 16, bootstrap: 20000",
+        "erpt, seeds: 64, chain_length: 16, bootstrap: 20000",
     ] {
         let images = replicates(integrator, 64);
         let mean = interior_mean(&images);

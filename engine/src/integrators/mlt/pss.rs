@@ -108,6 +108,12 @@ impl Chains {
         }
     }
 
+    /// Keeps the buffers but draws from the render seed `seed` from now on
+    /// (a new stream of chains).
+    pub fn reseed(&mut self, seed: u32) {
+        self.seed = Self::new(seed).seed;
+    }
+
     /// Number of slots.
     pub fn len(&self) -> usize {
         self.active
