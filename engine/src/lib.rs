@@ -64,6 +64,7 @@ pub fn builtin_registry() -> Registry {
     radiant_media::register(&mut registry);
     scene::register_gltf_image(&mut registry);
     integrators::module::register(&mut registry);
+    integrators::bdpt::register(&mut registry);
     integrators::mlt::register(&mut registry);
     registry
 }

@@ -233,6 +233,10 @@ pub(super) fn build(
         stats,
     };
     render.effects = effects(&render);
+    render
+        .integrator
+        .check(&render)
+        .map_err(|m| SceneError::new(&scene.file, scene.integrator.location, m))?;
     Ok(Sequence {
         render,
         geometry,

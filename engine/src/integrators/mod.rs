@@ -12,6 +12,7 @@
 //! stops sampling converged pixels in the tile driver.
 
 pub mod adaptive;
+pub mod bdpt;
 mod medium;
 pub mod mlt;
 pub mod module;

@@ -81,6 +81,14 @@ pub trait Integrator: Send + Sync {
     fn gpu(&self) -> bool {
         false
     }
+
+    /// Why it cannot render `scene` (a module without a side it needs, a
+    /// feature it does not handle), asked once the frame is extracted: the
+    /// message becomes an error at the scene's `integrator:`. `Ok` by
+    /// default.
+    fn check(&self, _scene: &RenderScene) -> Result<(), String> {
+        Ok(())
+    }
 }
 
 /// The driver families (see the module documentation).

@@ -1,0 +1,306 @@
+//! `bdpt` against `path`: the same image on the reference scenes, each
+//! connection strategy's own image against the path tracer's paths of the
+//! same length, every torture scene finite and terminating with
+//! `max_depth: -1`, and clear refusals of what it does not handle. (That
+//! the MIS weights of all strategies of a path sum to one is a unit test
+//! of `integrators::bdpt::mis`, against brute force.)
+//!
+//! Statistics: each render is made twice with independent seeds, so every
+//! comparison carries its own noise estimate. Blocks of 4 × 4 pixels are
+//! compared by the pooled ratio F = Σ D² / Σ σ̂², with D a block's
+//! difference of the two integrators' means and σ̂² = ((B₁ − B₂)² +
+//! (P₁ − P₂)²) / 4 the variance of D estimated from the halves; without
+//! bias F is near 1 (an F(64, 128) variable: its 99.99th percentile is
+//! about 2.1), so F < 2.5 is "within noise".
+//!
+//! Mutation check (done by hand, recorded here): scaling one strategy's
+//! value by 1.02 in `integrators/bdpt/mod.rs` fails both comparisons.
+//! Next-event estimation (s = 1): strategy (1, 2) is off by +2.1 % at
+//! 0.07 % noise (F = 17.7), and the reference-scene test fails. Light
+//! paths on the lens (t = 1): strategy (2, 1) is off by +1.6 % (F = 5.3),
+//! and spot-directional by +1.4 % (beyond 4 standard errors). Unmutated,
+//! every strategy lies within 3 standard errors and F ≤ 1.3, the
+//! reference scenes within 0.6 % (Cornell box; its noise is 0.45 %).
+
+// `unwrap`/`expect` in this test code is the assertion: the inputs are
+// the test's own, so a failure is a bug, and the panic reports it.
+
+use radiant::extract::{Overrides, extract};
+use radiant::film::Image;
+use radiant_tests::{channel_means, render_edited, root};
+
+/// `text` with its `integrator:` entry (flow or block style) replaced by
+/// `integrator` (a flow mapping).
+fn with_integrator(text: &str, integrator: &str) -> String {
+    let mut out = String::new();
+    let mut skipping = false;
+    for line in text.lines() {
+        if line.starts_with("integrator:") {
+            out += &format!("integrator: {integrator}\n");
+            skipping = true;
+            continue;
+        }
+        if skipping && line.starts_with(' ') {
+            continue;
+        }
+        skipping = false;
+        out += line;
+        out.push('\n');
+    }
+    out
+}
+
+/// `scene` rendered by `integrator` at `size`², `spp`, `seed`, `depth`.
+fn render(scene: &str, integrator: &str, spp: u32, seed: u64, size: u32, depth: i32) -> Image {
+    render_with(scene, integrator, spp, seed, size, depth, |t| t)
+}
+
+/// [`render`] with the scene's text changed by `edit` too.
+fn render_with(
+    scene: &str,
+    integrator: &str,
+    spp: u32,
+    seed: u64,
+    size: u32,
+    depth: i32,
+    edit: impl FnOnce(String) -> String,
+) -> Image {
+    let r = render_edited(
+        scene,
+        |text| edit(with_integrator(text, integrator)),
+        Overrides {
+            spp: Some(spp),
+            seed: Some(seed),
+            width: Some(size),
+            height: Some(size),
+            max_depth: Some(depth),
+            ..Default::default()
+        },
+    );
+    assert_eq!(r.invalid_samples, 0, "{scene}: NaN or infinite samples");
+    r.image
+}
+
+/// Two renders with independent seeds.
+fn halves(scene: &str, integrator: &str, spp: u32, seed: u64, size: u32, depth: i32) -> [Image; 2] {
+    [0, 1].map(|h| render(scene, integrator, spp, seed + 100 * h, size, depth))
+}
+
+/// Two renders of the Cornell box with a box filter (see
+/// `each_strategy_matches_paths_of_its_length`).
+fn box_halves(integrator: &str, spp: u32, seed: u64, depth: i32) -> [Image; 2] {
+    let boxed = |t: String| {
+        t.replace(
+            "filter: {type: gaussian, stddev: 0.5}",
+            "filter: {type: box}",
+        )
+    };
+    [0, 1].map(|h| {
+        render_with(
+            "scenes/cornell-box.yaml",
+            integrator,
+            spp,
+            seed + 100 * h,
+            16,
+            depth,
+            boxed,
+        )
+    })
+}
+
+/// Mean of each 4 × 4 block, over the channels.
+fn blocks(image: &Image) -> Vec<f64> {
+    radiant::compare::block_means(image, 4)
+}
+
+/// How two integrators' renders (each as two halves) compare.
+#[derive(Debug)]
+struct Comparison {
+    /// Per channel, mean(b) / mean(p) − 1.
+    mean_error: [f64; 3],
+    /// Per channel, the standard error of that ratio from the halves.
+    mean_sigma: [f64; 3],
+    /// Σ D² / Σ σ̂² over the blocks.
+    f: f64,
+}
+
+fn compare(b: &[Image; 2], p: &[Image; 2]) -> Comparison {
+    let m = |i: &Image| channel_means(i);
+    let (b1, b2, p1, p2) = (m(&b[0]), m(&b[1]), m(&p[0]), m(&p[1]));
+    let mut mean_error = [0.0; 3];
+    let mut mean_sigma = [0.0; 3];
+    for c in 0..3 {
+        let (mb, mp) = ((b1[c] + b2[c]) / 2.0, (p1[c] + p2[c]) / 2.0);
+        mean_error[c] = mb / mp - 1.0;
+        let var = ((b1[c] - b2[c]).powi(2) + (p1[c] - p2[c]).powi(2)) / 4.0;
+        mean_sigma[c] = var.sqrt() / mp;
+    }
+    let (bb1, bb2, pb1, pb2) = (blocks(&b[0]), blocks(&b[1]), blocks(&p[0]), blocks(&p[1]));
+    let (mut num, mut den) = (0.0, 0.0);
+    for i in 0..bb1.len() {
+        let d = (bb1[i] + bb2[i]) / 2.0 - (pb1[i] + pb2[i]) / 2.0;
+        num += d * d;
+        den += ((bb1[i] - bb2[i]).powi(2) + (pb1[i] - pb2[i]).powi(2)) / 4.0;
+    }
+    Comparison {
+        mean_error,
+        mean_sigma,
+        f: if den > 0.0 { num / den } else { 0.0 },
+    }
+}
+
+/// Global means within 1 % (and within 4 standard errors), blocks within
+/// noise.
+fn agrees(c: &Comparison) -> bool {
+    (0..3).all(|k| c.mean_error[k].abs() < 0.01 && c.mean_error[k].abs() < 4.0 * c.mean_sigma[k])
+        && c.f < 2.5
+}
+
+/// Global means within 4 standard errors, blocks within noise (for the
+/// unweighted strategies, some of which are far noisier than 1 %).
+fn within_noise(c: &Comparison) -> bool {
+    (0..3).all(|k| c.mean_error[k].abs() < 4.0 * c.mean_sigma[k]) && c.f < 2.5
+}
+
+#[test]
+fn converges_to_path_on_the_reference_scenes() {
+    // 32 × 32 pixels; path with 4× bdpt's samples (bdpt costs about 4× a
+    // path sample on these scenes). Measured (seeds as below): mean errors
+    // at most 0.3 %, F at most 1.4.
+    for (scene, spp) in [
+        ("scenes/cornell-box.yaml", 128),
+        ("scenes/glass.yaml", 128),
+        ("scenes/environment.yaml", 64),
+        ("scenes/spot-directional.yaml", 64),
+    ] {
+        let depth = radiant::scene::load(root().join(scene))
+            .expect("scene loads")
+            .settings
+            .max_depth;
+        let p = halves(scene, "{type: path}", 4 * spp, 1, 32, depth);
+        let b = halves(scene, "{type: bdpt}", spp, 2, 32, depth);
+        let c = compare(&b, &p);
+        eprintln!("{scene}: {c:?}");
+        assert!(agrees(&c), "{scene}: bdpt differs from path: {c:?}");
+    }
+}
+
+#[test]
+fn each_strategy_matches_paths_of_its_length() {
+    // The unweighted image of strategy (s, t) holds every path of
+    // s + t − 1 segments that it can make; on the Cornell box (diffuse,
+    // an area light) that is every such path, which path renders as
+    // max_depth k minus max_depth k − 1. With a box filter: a wider one
+    // loses the splats' share that falls outside the image at its
+    // border, which the tile film's normalization (Σ w·L / Σ w) does not
+    // (2.5 % of these 16 × 16 images with the scene's Gaussian).
+    for k in [2i32, 3] {
+        // The same seeds for both depths: the shorter paths' samples are the
+        // same in both renders and cancel exactly in the difference.
+        let p_hi = box_halves("{type: path}", 1024, 3, k);
+        let p_lo = box_halves("{type: path}", 1024, 3, k - 1);
+        let p = [0, 1].map(|h| difference(&p_hi[h], &p_lo[h]));
+        for s in 0..=k as usize {
+            let t = k as usize + 1 - s;
+            let integrator = format!("{{type: bdpt, strategy: [{s}, {t}]}}");
+            let b = box_halves(&integrator, 1024, 7, k);
+            let c = compare(&b, &p);
+            eprintln!("k {k} (s, t) = ({s}, {t}): {c:?}");
+            assert!(within_noise(&c), "strategy ({s}, {t}) differs: {c:?}");
+        }
+    }
+}
+
+fn difference(a: &Image, b: &Image) -> Image {
+    Image {
+        pixels: a
+            .pixels
+            .iter()
+            .zip(&b.pixels)
+            .map(|(x, y)| *x - *y)
+            .collect(),
+        ..a.clone()
+    }
+}
+
+#[test]
+fn torture_scenes_render_finite_and_terminate_unlimited() {
+    let mut rendered = 0;
+    for entry in std::fs::read_dir(root().join("scenes/hard")).expect("scenes/hard") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_none_or(|e| e != "yaml") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).expect("readable");
+        let text = with_integrator(&text, "{type: bdpt, max_depth: -1}");
+        let scene = radiant::scene::from_str(&text, &path, path.parent().expect("folder"))
+            .expect("scene parses");
+        let overrides = Overrides {
+            spp: Some(2),
+            width: Some(8),
+            height: Some(8),
+            ..Default::default()
+        };
+        match extract(&scene, &radiant::builtin_registry(), &overrides) {
+            Ok(r) => {
+                let out =
+                    radiant::backend::cpu::render(&r, &radiant::backend::cpu::Progress::none());
+                assert_eq!(
+                    out.invalid_samples,
+                    0,
+                    "{}: invalid samples",
+                    path.display()
+                );
+                assert!(
+                    out.image.pixels.iter().all(|p| p.is_finite()),
+                    "{}: non-finite pixels",
+                    path.display()
+                );
+                rendered += 1;
+            }
+            Err(e) => {
+                // The one refusal: cameras without an importance side.
+                let message = e.to_string();
+                assert!(
+                    text.contains("type: orthographic") && message.contains("`orthographic`"),
+                    "{}: {message}",
+                    path.display()
+                );
+            }
+        }
+    }
+    assert!(rendered >= 20, "only {rendered} torture scenes rendered");
+}
+
+#[test]
+fn unsupported_modules_are_refused_by_name() {
+    let text = std::fs::read_to_string(root().join("scenes/cornell-box.yaml")).expect("scene");
+    let text = with_integrator(&text, "{type: bdpt}").replacen(
+        "type: perspective",
+        "type: spherical\n  # fov: unused",
+        1,
+    );
+    let text = text
+        .replace("  fov: ", "  # fov: ")
+        .replace("  fov_axis: ", "  # fov_axis: ");
+    let dir = root().join("scenes");
+    let scene = radiant::scene::from_str(&text, std::path::Path::new("cornell.yaml"), &dir)
+        .expect("scene parses");
+    let err = extract(&scene, &radiant::builtin_registry(), &Overrides::default())
+        .err()
+        .expect("bdpt refuses a spherical camera");
+    let message = err.to_string();
+    assert!(
+        message.contains("`spherical`") && message.contains("importance"),
+        "{message}"
+    );
+    // A bad strategy is a located parameter error.
+    let text = std::fs::read_to_string(root().join("scenes/cornell-box.yaml")).expect("scene");
+    let text = with_integrator(&text, "{type: bdpt, strategy: [2, 0]}");
+    let scene = radiant::scene::from_str(&text, std::path::Path::new("cornell.yaml"), &dir)
+        .expect("scene parses");
+    let err = extract(&scene, &radiant::builtin_registry(), &Overrides::default())
+        .err()
+        .expect("t = 0 is refused");
+    assert!(err.to_string().contains("t ≥ 1"), "{err}");
+}
