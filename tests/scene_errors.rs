@@ -78,9 +78,9 @@ fn unknown_module_type_lists_the_known_ones_and_suggests_the_closest() {
         ],
     );
     fails_at(
-        &format!("{CAMERA}integrator: {{type: bdpt}}\n"),
+        &format!("{CAMERA}integrator: {{type: photon_map}}\n"),
         2,
-        &["unknown integrator type `bdpt`", "path"],
+        &["unknown integrator type `photon_map`", "path"],
     );
 }
 

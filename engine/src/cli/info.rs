@@ -136,7 +136,8 @@ pub fn run(registry: &Registry, args: &InfoArgs) -> miette::Result<()> {
         s.max_depth.to_string()
     };
     println!(
-        "integrator   path, max_depth {depth}, rr_depth {}",
+        "integrator   {}, max_depth {depth}, rr_depth {}",
+        radiant::backend::cpu::integrator_name(&r),
         s.rr_depth
     );
     println!("triangles    {}", r.stats.triangles);
