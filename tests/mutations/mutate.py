@@ -78,6 +78,15 @@ MUTATIONS = [
      "self.distribution.pdf(c) / (rows * TAU * band) * if 2 * c.y > self.size.y { 1.03 } else { 1.0 }"),
     ("srgb-gamma-2.2", "sRGB decoded by a plain 2.2 power", "modules/textures/src/srgb.rs",
      "((c + 0.055) / 1.055).powf(2.4)", "c.powf(2.2)"),
+    ("spatial-mis-pmf+2%", "spatial light selection: MIS probability 2 % above the chosen one",
+     "engine/src/extract/lights.rs",
+     "share * b.importance(p) / total", "1.02 * share * b.importance(p) / total"),
+    ("light-tree-mis-pmf+2%", "light tree: MIS probability 2 % above the chosen one",
+     "engine/src/extract/lights.rs",
+     "return share * tree.pmf(p, slot);", "return 1.02 * share * tree.pmf(p, slot);"),
+    ("spot-bounds-narrow", "spot light bounds: fall-off cone 10 % narrower than the light's",
+     "modules/lights/src/spot.rs",
+     "(self.cutoff - self.beam).cos(),", "(0.9 * (self.cutoff - self.beam)).cos(),"),
 ]
 
 # The tests that pin sampling routines: the module crates' unit tests and
@@ -89,6 +98,7 @@ SAMPLING_SUITE = [
     "--test", "shaders_energy", "--test", "shaders_sampling", "--test", "shaders_scenes",
     "--test", "depth_of_field", "--test", "environment", "--test", "cornell_box",
     "--test", "lens_and_filter_sampling", "--test", "delta_lights", "--test", "torture_lights",
+    "--test", "light_selection",
 ]
 
 
