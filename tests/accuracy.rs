@@ -300,3 +300,34 @@ fn the_budget_bounds_the_whole_run_reference_included() {
     assert!(points > report.curves.len(), "{points} points");
     assert!(wall >= budget.mul_f64(0.6), "{wall:?}");
 }
+
+#[test]
+fn integrator_and_adaptive_axes_are_measured_by_whole_renders() {
+    let mut c = config(&[Axis::Integrator, Axis::Adaptive]);
+    c.max_spp = 32;
+    let report = sweep(&c);
+    let labels: Vec<String> = report.curves.iter().map(|c| c.setting.label()).collect();
+    let integrators = radiant::builtin_registry()
+        .names::<dyn radiant::integrators::Integrator>()
+        .len();
+    // The baseline, every integrator but `path`, and adaptive sampling.
+    assert_eq!(labels.len(), 1 + (integrators - 1) + 1, "{labels:?}");
+    for curve in &report.curves {
+        let spp: Vec<u32> = curve.points.iter().map(|p| p.spp).collect();
+        assert_eq!(spp, [2, 4, 8, 16, 32], "{}", curve.setting.label());
+        assert!(
+            curve.points.iter().all(|p| p.metrics.rmse.is_finite()),
+            "{}",
+            curve.setting.label()
+        );
+    }
+    // Adaptive sampling is unbiased, and its error falls with its most spp.
+    let adaptive = report
+        .curves
+        .iter()
+        .find(|c| c.setting.label() == "adaptive=on")
+        .unwrap();
+    assert!(!adaptive.is_biased(), "{:?}", adaptive.last());
+    let (first, last) = (&adaptive.points[0], adaptive.last().unwrap());
+    assert!(last.metrics.rmse < 0.5 * first.metrics.rmse);
+}
