@@ -11,9 +11,9 @@
 //!   image averages biases it: a pixel whose estimate happens to be high
 //!   looks converged (σ/μ small) and stops, keeping the high value, while
 //!   a low one goes on and is pulled back up. So the decision is made on
-//!   *separate* samples: every round of `batch` image samples (sample
-//!   indices 0, 1, 2, … of the pixel) also renders `batch / 4` decision
-//!   samples, drawn with sample indices from [`DECISION_BASE`] on
+//!   *separate* samples: every round of image samples (sample indices
+//!   0, 1, 2, … of the pixel; `min_spp` in the first, `batch` after) also
+//!   renders a quarter as many decision samples (at least 2), drawn with sample indices from [`DECISION_BASE`] on
 //!   (independent of the image's: samplers draw sample i from the seed,
 //!   the pixel and i alone) and never added to the image. Given the
 //!   decisions, the image's samples are independent draws, so the image
@@ -168,11 +168,12 @@ impl Adaptive {
         let first = self.min_spp.unwrap_or(self.batch).div_ceil(self.batch) * self.batch;
         (first.min(most), most)
     }
+}
 
-    /// Decision samples per round of `batch` image samples.
-    pub fn decision_samples(&self) -> u32 {
-        (self.batch / DECISION_SHARE).max(2)
-    }
+/// Decision samples for a round of `image` image samples: a
+/// [`DECISION_SHARE`]th of them, at least 2 (the variance needs two).
+pub fn decision_samples(image: u32) -> u32 {
+    (image / DECISION_SHARE).max(2)
 }
 
 /// The standard normal quantile Φ⁻¹(p) for p in (0, 1) (Acklam's rational
@@ -299,7 +300,7 @@ pub fn run_tile(
     let mut counts = vec![0u32; len];
     let mut active = vec![true; len];
     let (first, most) = a.limits(spp);
-    let (z, per_round) = (a.z(), a.decision_samples());
+    let z = a.z();
     let (mut n, mut decided) = (0, 0);
     loop {
         let target = if n == 0 {
@@ -310,6 +311,7 @@ pub fn run_tile(
         for_runs(&active, t, n..target, &mut |b| {
             render(b, false, &mut |_, _| ())
         });
+        let per_round = decision_samples(target - n);
         let samples = DECISION_BASE + decided..DECISION_BASE + decided + per_round;
         for_runs(&active, t, samples, &mut |b| {
             render(b, true, &mut |p, v| {
