@@ -957,3 +957,26 @@ impl Sample<'_, '_> {
         total
     }
 }
+
+#[cfg(test)]
+mod tests {
+    // `unwrap` in this test code is the assertion: the inputs are the test's
+    // own, so a failure is a bug, and the panic reports it with the error.
+    use super::*;
+    use radiant_core::params::check_param_docs;
+
+    #[test]
+    fn documented_parameters_match() {
+        check_param_docs::<BdptParams>(DOCS).unwrap();
+    }
+
+    #[test]
+    fn dimensions_of_vertices_do_not_overlap() {
+        // Each vertex index owns VERTEX_DIMS dimensions after the camera's
+        // and the light subpath's start; the last one used is the lens
+        // pair at +11..+12.
+        assert_eq!(dims(0), CAMERA_DIMS + LIGHT_DIMS);
+        assert_eq!(dims(1) - dims(0), VERTEX_DIMS);
+        const { assert!(11 + 2 <= VERTEX_DIMS) };
+    }
+}
