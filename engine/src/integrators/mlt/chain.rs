@@ -23,6 +23,9 @@ pub struct Current {
     raster: Vec<Vec2>,
     /// Weight gathered since the state became current, not yet splatted.
     pending: Vec<f32>,
+    /// Factor of every deposit of the slot's chain (1 but for the chains
+    /// of a seed too bright to be split into chains of the usual energy).
+    weight: Vec<f32>,
 }
 
 impl Current {
@@ -32,6 +35,7 @@ impl Current {
         self.target.resize(n, 0.0);
         self.raster.resize(n, Vec2::ZERO);
         self.pending.resize(n, 0.0);
+        self.weight.resize(n, 1.0);
     }
 
     /// Makes slot `slot`'s last traced proposal (in `tracer`) its current
@@ -41,6 +45,7 @@ impl Current {
         self.target[slot] = tracer.target[slot];
         self.raster[slot] = tracer.raster(slot);
         self.pending[slot] = 0.0;
+        self.weight[slot] = 1.0;
     }
 
     /// Starts slot `slot` on slot `from` of `other` (its current state).
@@ -49,6 +54,12 @@ impl Current {
         self.target[slot] = other.target[from];
         self.raster[slot] = other.raster[from];
         self.pending[slot] = 0.0;
+        self.weight[slot] = 1.0;
+    }
+
+    /// Multiplies every deposit of slot `slot`'s chain by `weight`.
+    pub fn set_weight(&mut self, slot: usize, weight: f32) {
+        self.weight[slot] = weight;
     }
 
     /// The target value of slot `slot`'s current state.
@@ -74,7 +85,8 @@ impl Current {
                 self.pending[slot] = a;
                 accepted += 1;
             } else if a > 0.0 && proposed > 0.0 {
-                splats.splat(tracer.raster(slot), tracer.value[slot] * (a / proposed));
+                let w = self.weight[slot] * a / proposed;
+                splats.splat(tracer.raster(slot), tracer.value[slot] * w);
             }
         }
         accepted
@@ -90,7 +102,8 @@ impl Current {
     fn flush_slot(&mut self, slot: usize, splats: &SplatFilm) {
         let (w, t) = (self.pending[slot], self.target[slot]);
         if w > 0.0 && t > 0.0 {
-            splats.splat(self.raster[slot], self.value[slot] * (w / t));
+            let w = self.weight[slot] * w / t;
+            splats.splat(self.raster[slot], self.value[slot] * w);
         }
         self.pending[slot] = 0.0;
     }

@@ -38,6 +38,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// Seed paths traced per batch; also the most chains one wavefront
 /// advances.
 const BATCH: usize = 1024;
+/// The largest share of the budget (in mutations) one seed path's chains
+/// may take.
+const MAX_SHARE: f64 = 1.0 / 16.0;
 
 /// The `erpt` integrator.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -152,6 +155,8 @@ struct Worker {
     current: Current,
     /// Seed slot of every chain to run, in order.
     queue: Vec<u32>,
+    /// Deposit factor of each seed's chains (see `MAX_SHARE`).
+    seed_weight: Vec<f32>,
 }
 
 impl ChainIntegrator for Erpt {
@@ -172,6 +177,8 @@ impl ChainIntegrator for Erpt {
         // Energy of one deposit, in units of the target (luminance).
         let energy = f64::from(self.seeds) * boot.mean / spp;
         let per_chain = energy * f64::from(self.chain_length);
+        let budget = f64::from(ctx.spp.max(1)) * f64::from(w) * f64::from(h);
+        let max_chains = (budget * MAX_SHARE / f64::from(self.chain_length)).max(1.0);
         let settings_seed = scene.settings.seed;
         let seed_stream = stream_seed(settings_seed, Stream::Seeds);
         let choices = stream_seed(settings_seed, Stream::Choices);
@@ -197,13 +204,24 @@ impl ChainIntegrator for Erpt {
                     }
                     wk.tracer.trace(scene, &wk.seeds);
                     wk.queue.clear();
+                    wk.seed_weight.clear();
                     for slot in 0..n {
                         wk.seeds.accept(slot);
                         wk.seed_state.start(slot, &wk.tracer);
                         let t = f64::from(wk.tracer.target[slot]);
                         let xi = unit_float(hash4(choices, (first + slot as u64) as u32, 1, 0));
-                        let count = (f64::from(xi) + t / per_chain).floor() as usize;
+                        let chains = t / per_chain;
+                        // A seed worth more chains than a share of the
+                        // budget (a firefly) gets that many, each
+                        // depositing proportionally more: the same
+                        // expectation without one path taking the render.
+                        let (count, weight) = if chains > max_chains {
+                            (max_chains as usize, (chains / max_chains) as f32)
+                        } else {
+                            ((f64::from(xi) + chains).floor() as usize, 1.0)
+                        };
                         wk.queue.extend(std::iter::repeat_n(slot as u32, count));
+                        wk.seed_weight.push(weight);
                     }
                     wk.chains
                         .reseed(stream_seed(settings_seed, Stream::Redistribution(b as u32)));
@@ -217,6 +235,7 @@ impl ChainIntegrator for Erpt {
                             wk.chains
                                 .start_from(k, next_chain, &wk.seeds, seed_slot as usize);
                             wk.current.start_from(k, &wk.seed_state, seed_slot as usize);
+                            wk.current.set_weight(k, wk.seed_weight[seed_slot as usize]);
                             next_chain += 1;
                         }
                         for _ in 0..self.chain_length {
