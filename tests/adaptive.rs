@@ -192,3 +192,24 @@ fn a_gaussian_film_keeps_converged_pixels_their_value() {
     assert!((ratio - 1.0).abs() < 0.02, "adaptive / fixed mean {ratio}");
     assert!(adaptive.samples < fixed.samples, "the light stopped early");
 }
+
+#[test]
+fn passes_and_the_gpu_refuse_adaptive_sampling_by_name() {
+    let text = scene(ADAPTIVE);
+    let loaded = radiant::scene::from_str(&text, Path::new("adaptive.yaml"), Path::new("."))
+        .expect("the scene parses");
+    let r =
+        extract(&loaded, &radiant::builtin_registry(), &Overrides::default()).expect("extracts");
+    let err = match radiant::backend::cpu::passes(&r) {
+        Ok(_) => panic!("adaptive sampling renders in passes"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        err.contains("adaptive sampling") && err.contains("--time") && !err.contains("  "),
+        "{err}"
+    );
+    let gpu = radiant::backend::gpu::Plan::check(&r)
+        .expect_err("refused")
+        .to_string();
+    assert!(gpu.contains("adaptive"), "{gpu}");
+}

@@ -176,7 +176,8 @@ fn add_splats(splats: Option<&SplatFilm>, image: &mut Image, samples: u64) -> u6
 pub fn passes(scene: &RenderScene) -> Result<&dyn TileIntegrator, RenderError> {
     let refuse = |why: &str| {
         Err(RenderError::NoPasses(format!(
-            "{why}; `--time`, `--checkpoint`, `--resume`, `--partition` and `radiant merge` need              renders in passes of whole samples of every pixel"
+            "{why}; `--time`, `--checkpoint`, `--resume`, `--partition` and `radiant merge` need \
+             renders in passes of whole samples of every pixel"
         )))
     };
     let name = integrator_name(scene);
