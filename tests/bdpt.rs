@@ -269,3 +269,35 @@ fn unsupported_modules_are_refused_by_name() {
         .expect("t = 0 is refused");
     assert!(err.to_string().contains("t ≥ 1"), "{err}");
 }
+
+#[test]
+fn output_variables_are_the_camera_rays_first_hits() {
+    // bdpt's camera rays are path's (the same film and lens samples), so
+    // its first-hit layers (for --aov and the denoiser) are path's.
+    let aovs = |integrator: &str| {
+        let text = std::fs::read_to_string(root().join("scenes/cornell-box.yaml")).expect("scene");
+        let text = with_integrator(&text, integrator);
+        let scene = radiant::scene::from_str(
+            &text,
+            std::path::Path::new("cornell.yaml"),
+            &root().join("scenes"),
+        )
+        .expect("scene parses");
+        let overrides = Overrides {
+            spp: Some(4),
+            width: Some(24),
+            height: Some(24),
+            ..Default::default()
+        };
+        let r = extract(&scene, &radiant::builtin_registry(), &overrides).expect("extracts");
+        radiant::backend::cpu::render_with_aovs(&r, &radiant::backend::cpu::Progress::none())
+            .expect("fits in memory")
+            .1
+    };
+    let (p, b) = (aovs("{type: path}"), aovs("{type: bdpt}"));
+    assert!(p.alpha.iter().any(|a| *a > 0.0));
+    assert_eq!(p.alpha, b.alpha);
+    assert_eq!(p.albedo, b.albedo);
+    assert_eq!(p.normal, b.normal);
+    assert_eq!(p.depth, b.depth);
+}

@@ -53,6 +53,7 @@ use super::surface::{Derivatives, interaction, interaction_with_derivatives};
 use crate::accel::offset::{offset_origin, sampled_point_error};
 use crate::extract::{NO_EMITTER, RenderScene};
 use crate::film::Reconstruction;
+use crate::film::aov::FirstHit;
 use crate::film::exact::BLOCK;
 use glam::{Vec2, Vec3};
 use radiant_core::{
@@ -205,6 +206,8 @@ pub struct Worker {
     dir: Vec<Vec3>,
     weight: Vec<f32>,
     values: Vec<Rgb>,
+    /// The camera rays' first hits, where the render records them.
+    first_hits: Vec<FirstHit>,
     only: Option<(usize, usize)>,
     camera: Subpath,
     light: Subpath,
@@ -219,6 +222,10 @@ impl TileWorker for Worker {
         let mut shading = Shading::new(scene);
         self.values.clear();
         self.values.resize(n, Rgb::ZERO);
+        if out.aovs.is_some() {
+            self.first_hits.clear();
+            self.first_hits.resize(n, FirstHit::default());
+        }
         let values = &mut self.values;
         for (i, value) in values.iter_mut().enumerate() {
             let mut sample = Sample {
@@ -233,6 +240,9 @@ impl TileWorker for Worker {
             };
             *value = sample.run(self.origin[i], self.dir[i], self.weight[i]);
             self.rays += sample.rays;
+            if out.aovs.is_some() {
+                self.first_hits[i] = first_hit(scene, &mut shading, &self.camera, self.origin[i]);
+            }
         }
         for (first, index) in (0..count).zip(batch.first_sample..) {
             for i in (first..n).step_by(count) {
@@ -258,6 +268,15 @@ impl TileWorker for Worker {
             for (id, v) in self.ids[..n].iter().zip(values.iter()) {
                 add(id.pixel, *v);
             }
+        }
+        if let Some(aovs) = out.aovs {
+            aovs.add_samples(
+                ctx.reconstruction,
+                self.ids[..n].iter().map(|id| id.pixel),
+                &self.film[..n],
+                &self.filter_weight,
+                &self.first_hits[..n],
+            );
         }
     }
 
@@ -317,6 +336,26 @@ impl Worker {
             },
         );
         n
+    }
+}
+
+/// What the camera ray of a sample whose camera subpath is `camera`
+/// found first (the output variables'), from the ray's `origin`.
+fn first_hit(
+    scene: &RenderScene,
+    shading: &mut Shading<'_>,
+    camera: &Subpath,
+    origin: Vec3,
+) -> FirstHit {
+    match camera.v.get(1) {
+        Some(v) => FirstHit {
+            alpha: 1.0,
+            albedo: shading.albedo(v),
+            normal: v.it.frame.n,
+            depth: (v.it.p - origin).length(),
+            position: (v.it.p.as_dvec3() + scene.render_origin).as_vec3(),
+        },
+        None => FirstHit::default(),
     }
 }
 

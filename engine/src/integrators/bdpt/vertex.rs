@@ -141,6 +141,14 @@ impl<'a> Shading<'a> {
         s
     }
 
+    /// The albedo of `v`'s material seen from `v.wo` (for the output
+    /// variables).
+    pub(super) fn albedo(&mut self, v: &Vertex) -> Rgb {
+        let mut out = [Rgb::ZERO];
+        self.call(v, v.wo, |s, ctx, batch| s.albedo(ctx, batch, &mut out));
+        out[0]
+    }
+
     /// Whether `v`'s material has a smooth lobe (connections can reach it).
     pub(super) fn connectable(&self, v: &Vertex) -> bool {
         v.kind == Kind::Surface
