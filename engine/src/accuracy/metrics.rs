@@ -21,6 +21,15 @@
 //! of bias it reports, 1 − threshold/z², is the part of the block-mean
 //! differences that noise cannot explain at the test's confidence: above
 //! zero exactly when the setting is called biased.
+//!
+//! A setting may render without noise where the halves agree bit for bit
+//! (a constant sky seen directly, or the whole image: a path length that
+//! stops every path before it samples anything). Such a block's D is then
+//! exact and H is zero, so each block's noise has a floor,
+//! [`PRECISION`] of the block's level: the precision of a reference read
+//! from a file (a half-float EXR rounds to 5·10⁻⁴). Without it a
+//! noise-free image had no block to test and was never called biased
+//! however far it was from the reference.
 
 use crate::compare::compare;
 use crate::film::Image;
@@ -37,6 +46,12 @@ const BIAS_TEST_Z: f64 = 3.5;
 /// Smallest threshold of the bias test's ratio, for images with so many
 /// blocks that a bias far below the noise would be flagged.
 const MIN_BIAS_THRESHOLD: f64 = 1.25;
+
+/// Relative precision of a block mean: differences from the reference
+/// below this fraction of the block's level (mean |value| of the image and
+/// the reference) are taken as rounding, not bias. Above a half-float EXR's
+/// rounding (2⁻¹¹ ≈ 4.9·10⁻⁴ of the value).
+pub const PRECISION: f64 = 1e-3;
 
 /// How far an image is from the reference.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -232,6 +247,7 @@ pub fn bias_split(
     let mut half = vec![[0.0f64; 3]; nb];
     let mut count = vec![0u32; nb];
     let mut pixel_var = vec![0.0f64; nb];
+    let mut level = vec![0.0f64; nb];
     for y in 0..h {
         for x in 0..w {
             let i = (y * w + x) as usize;
@@ -245,25 +261,37 @@ pub fn bias_split(
                 d[b][c] += di[c] as f64;
                 half[b][c] += (hi[c] + hr[c]) as f64;
                 pixel_var[b] += (hi[c] as f64).powi(2) + (hr[c] as f64).powi(2);
+                level[b] +=
+                    0.5 * f64::from(combined.pixels[i][c].abs() + reference.pixels[i][c].abs());
             }
             count[b] += 1;
         }
     }
-    // Per block, the squared block means summed over the channels, each
-    // weighted by the inverse of its pixels' summed squared half
-    // differences (blocks without noise are left out).
-    let weighted = |sums: &[[f64; 3]]| -> Vec<f64> {
+    // Per block, the squared block means summed over the channels plus
+    // (for H) the precision floor's variance, each weighted by the inverse
+    // of its pixels' summed squared half differences with the floor added
+    // in the same units (count² times the block mean's); blocks with
+    // neither noise nor light are left out: their D is zero.
+    let floor: Vec<f64> = level
+        .iter()
+        .zip(&count)
+        .map(|(l, &c)| 3.0 * (PRECISION * l / f64::from(3 * c.max(1))).powi(2))
+        .collect();
+    let weighted = |sums: &[[f64; 3]], with_floor: bool| -> Vec<f64> {
         sums.iter()
             .zip(&count)
-            .zip(&pixel_var)
-            .filter(|(_, v)| **v > 0.0)
-            .map(|((s, &c), v)| {
-                let m2: f64 = s.iter().map(|x| (x / f64::from(c.max(1))).powi(2)).sum();
-                m2 / v
+            .zip(pixel_var.iter().zip(&floor))
+            .map(|((s, &c), (v, f))| {
+                let c = f64::from(c.max(1));
+                let v = v + c * c * f;
+                let m2: f64 = s.iter().map(|x| (x / c).powi(2)).sum();
+                (m2 + if with_floor { *f } else { 0.0 }, v)
             })
+            .filter(|(_, v)| *v > 0.0)
+            .map(|(m2, v)| m2 / v)
             .collect()
     };
-    let (d2, h2) = (weighted(&d), weighted(&half));
+    let (d2, h2) = (weighted(&d, false), weighted(&half, true));
     let (sd, sh): (f64, f64) = (d2.iter().sum(), h2.iter().sum());
     let block_z2 = if sh > 0.0 {
         sd / sh
@@ -395,6 +423,60 @@ mod tests {
                 biased.is_biased() && biased.bias_share() > 0.5,
                 "{biased:?}"
             );
+        }
+    }
+
+    #[test]
+    fn a_noise_free_image_is_tested_against_the_reference_precision() {
+        // Both halves alike bit for bit, as where a setting stops every path
+        // before it samples anything: 10 % off the reference is biased
+        // (before the precision floor no block had noise, z² fell back to
+        // 1 and the threshold to e⁷, and it passed), a reference's
+        // half-float rounding (±4.9·10⁻⁴ of the value) is not.
+        let r = image(64, 64, |x, y| {
+            Rgb::new(0.15, 0.2, 0.3) * (1.0 + ((x / 5 + y / 3) % 4) as f32)
+        });
+        let scaled = |f: &dyn Fn(u32, u32) -> f32| {
+            image(64, 64, |x, y| r.pixels[(y * 64 + x) as usize] * f(x, y))
+        };
+        let dark = scaled(&|_, _| 0.9);
+        let s = bias_split(Halves { a: &dark, b: &dark }, &r, None);
+        assert!(s.is_biased() && s.bias_share() > 0.99, "{s:?}");
+        let black = scaled(&|_, _| 0.0);
+        let s = bias_split(
+            Halves {
+                a: &black,
+                b: &black,
+            },
+            &r,
+            None,
+        );
+        assert!(s.is_biased() && s.bias_share() > 0.99, "{s:?}");
+        let rounded = scaled(&|x, y| 1.0 + 4.9e-4 * if (x + y) % 2 == 0 { 1.0 } else { -1.0 });
+        let s = bias_split(
+            Halves {
+                a: &rounded,
+                b: &rounded,
+            },
+            &r,
+            None,
+        );
+        assert!(!s.is_biased(), "{s:?}");
+        let same = bias_split(Halves { a: &r, b: &r }, &r, None);
+        assert!(!same.is_biased() && same.block_z2 == 0.0, "{same:?}");
+        // Noise-free where the image is a constant sky, noisy elsewhere:
+        // unbiased, and an offset of the noisy part is still found.
+        for (offset, biased) in [(0.0, false), (1.0, true)] {
+            let half = |seed| {
+                let n = noisy(&r, seed, offset, 1);
+                image(64, 64, |x, y| {
+                    let i = (y * 64 + x) as usize;
+                    if x < 32 { r.pixels[i] } else { n.pixels[i] }
+                })
+            };
+            let (a, b) = (half(1), half(2));
+            let s = bias_split(Halves { a: &a, b: &b }, &r, None);
+            assert_eq!(s.is_biased(), biased, "offset {offset}: {s:?}");
         }
     }
 
