@@ -14,7 +14,7 @@
 
 use glam::{Mat3, Mat4, UVec2, Vec2, Vec3};
 use radiant::film::output::read_exr;
-use radiant_cameras::{FovAxis, Perspective, ThinLens};
+use radiant_cameras::{FovAxis, Orthographic, Perspective, ThinLens};
 use radiant_core::{
     BoundingSphere, Camera, CameraRayPdf, CameraRays, EmissionKind, EmissionPdf, EmissionSample,
     EmittedRay, EmitterShape, Frame, LensSample, Light, Rgb,
@@ -426,4 +426,45 @@ fn importance_and_densities_give_the_camera_ray_weight() {
         );
         assert!(out.iter().all(|s| s.pdf == 0.0));
     }
+}
+
+#[test]
+fn orthographic_connections_land_where_its_rays_start() {
+    // One direction for all rays: a point connects to the window point
+    // below it, at the film position that made the ray, with density 1
+    // and importance 1 / window area = pdf_pos (We / (pdf_pos pdf_dir) = 1).
+    let camera = Orthographic::new(Mat4::IDENTITY, Vec2::new(32.0, 24.0), 3.0).unwrap();
+    let importance = camera.importance().unwrap();
+    assert!(importance.directional());
+    let mut rng = Rng::new(14);
+    for _ in 0..1000 {
+        let film = rng.next_2d() * Vec2::new(32.0, 24.0);
+        let (mut o, mut d, mut w) = ([Vec3::ZERO], [Vec3::ZERO], [0.0]);
+        camera.generate(
+            &[film],
+            &[Vec2::ZERO],
+            CameraRays {
+                origins: &mut o,
+                directions: &mut d,
+                weights: &mut w,
+            },
+        );
+        let mut s = [LensSample::default()];
+        importance.sample_wi(&[o[0] + d[0] * 2.5], &[Vec2::ZERO], &mut s);
+        let pdf = ray_pdfs(&camera, &[(o[0], d[0])])[0];
+        assert!((s[0].p - o[0]).length() < 1e-5 && (s[0].raster - film).length() < 1e-3);
+        assert_eq!((s[0].pdf, pdf.pdf_dir), (1.0, 1.0));
+        assert!((s[0].importance / pdf.pdf_pos - 1.0).abs() < 1e-6);
+        assert!(
+            (pdf.pdf_pos * 3.0 * 2.25 - 1.0).abs() < 1e-5,
+            "1 / window area"
+        );
+    }
+    // Behind the window and beside it: no connection.
+    let out = connect(
+        &camera,
+        &[Vec3::new(0.0, 0.0, -1.0), Vec3::new(5.0, 0.0, 1.0)],
+        15,
+    );
+    assert!(out.iter().all(|s| s.pdf == 0.0));
 }

@@ -7,7 +7,9 @@
 
 use crate::projection::{InvalidParam, Raster, check_min, gpu_pose};
 use radiant_core::glam::{Mat4, Vec2, Vec3};
-use radiant_core::{Camera, CameraRays, GpuModule, ParamDoc, Registry};
+use radiant_core::{
+    Camera, CameraRayPdf, CameraRays, GpuModule, Importance, LensSample, ParamDoc, Registry,
+};
 use serde::Deserialize;
 
 #[derive(Debug, Deserialize)]
@@ -56,7 +58,59 @@ impl Orthographic {
     }
 }
 
+/// Connections to the window: each point in front of it is seen along the
+/// view direction from exactly one window point, whose density is
+/// 1 / window area (pbrt's convention for a delta direction).
+impl Importance for Orthographic {
+    fn sample_wi(&self, refs: &[Vec3], _u: &[Vec2], out: &mut [LensSample]) {
+        let to_camera = self.to_render.inverse();
+        let dir = self.direction();
+        let area = 4.0 * self.half.x * self.half.y;
+        let size = 2.0 / self.raster.scale();
+        for (r, o) in refs.iter().zip(out.iter_mut()) {
+            *o = LensSample::default();
+            let q = to_camera.transform_point3(*r);
+            if q.z <= 0.0 {
+                continue;
+            }
+            let ndc = Vec2::new(-q.x / self.half.x, q.y / self.half.y);
+            let raster = Vec2::new((ndc.x + 1.0) * size.x, (1.0 - ndc.y) * size.y) * 0.5;
+            if !(raster.x >= 0.0 && raster.y >= 0.0 && raster.x < size.x && raster.y < size.y) {
+                continue;
+            }
+            *o = LensSample {
+                p: self.to_render.transform_point3(Vec3::new(q.x, q.y, 0.0)),
+                wi: -dir,
+                raster,
+                importance: 1.0 / area,
+                pdf: 1.0,
+            };
+        }
+    }
+
+    fn pdf_ray(&self, rays: &[(Vec3, Vec3)], out: &mut [CameraRayPdf]) {
+        let to_camera = self.to_render.inverse();
+        let area = 4.0 * self.half.x * self.half.y;
+        for ((origin, _), o) in rays.iter().zip(out.iter_mut()) {
+            let q = to_camera.transform_point3(*origin);
+            let inside = q.x.abs() <= self.half.x && q.y.abs() <= self.half.y;
+            *o = CameraRayPdf {
+                pdf_pos: if inside { 1.0 / area } else { 0.0 },
+                pdf_dir: 1.0,
+            };
+        }
+    }
+
+    fn directional(&self) -> bool {
+        true
+    }
+}
+
 impl Camera for Orthographic {
+    fn importance(&self) -> Option<&dyn Importance> {
+        Some(self)
+    }
+
     fn generate(&self, film: &[Vec2], _lens: &[Vec2], out: CameraRays<'_>) {
         let dir = self.direction();
         for (i, p) in film.iter().enumerate() {

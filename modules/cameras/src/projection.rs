@@ -67,6 +67,11 @@ impl Raster {
         params.f32(self.scale.x).f32(self.scale.y)
     }
 
+    /// The raster scale: 2 / resolution per axis.
+    pub(crate) fn scale(&self) -> Vec2 {
+        self.scale
+    }
+
     /// Raster pixels (top-left origin, +y down) to NDC ([−1, 1]², +y up).
     #[inline]
     pub(crate) fn ndc(&self, p: Vec2) -> Vec2 {

@@ -56,6 +56,15 @@ pub trait Importance: Send + Sync {
     /// uniform over the whole film and uniform lens samples, produces each
     /// ray (`origin`, unit `dir`) of `rays`, writing every `out[i]`.
     fn pdf_ray(&self, rays: &[(Vec3, Vec3)], out: &mut [CameraRayPdf]);
+
+    /// Whether every camera ray has the same direction (`orthographic`):
+    /// `pdf_dir` is then a delta, reported as 1, a scene point's density
+    /// from the camera is `pdf_pos` · |cos θ| at the point, and
+    /// [`sample_wi`](Self::sample_wi) finds the one lens point of each
+    /// reference point with density 1 and importance `pdf_pos`.
+    fn directional(&self) -> bool {
+        false
+    }
 }
 
 /// Output slices of [`Camera::generate`]; all have the batch's length.

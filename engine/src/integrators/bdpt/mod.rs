@@ -92,8 +92,8 @@ pub fn check(scene: &RenderScene) -> Result<(), String> {
             .map_or("?", |(_, n)| n.as_str());
         return Err(format!(
             "`bdpt` connects light paths to the camera, and the camera type `{camera}` has no \
-             importance side (`Camera::importance`); use `perspective` or `thin_lens`, or the \
-             `path` integrator"
+             importance side (`Camera::importance`); use `perspective`, `thin_lens` or \
+             `orthographic`, or the `path` integrator"
         ));
     }
     for (i, light) in scene.lights.lights().iter().enumerate() {
@@ -686,7 +686,11 @@ impl Sample<'_, '_> {
         }
         let mut pdf = [CameraRayPdf::default()];
         importance.pdf_ray(&[(ls.p, -w)], &mut pdf);
-        let rev_end = b.area_density(ls.p, pdf[0].pdf_dir);
+        let rev_end = if importance.directional() {
+            pdf[0].pdf_pos * b.it.ng.dot(w).abs()
+        } else {
+            b.area_density(ls.p, pdf[0].pdf_dir)
+        };
         let light_sum = side_sum(&self.light.mis[..=k], Side::Light, k, rev_end, rev_prev);
         let lens = Vertex::point(Kind::Camera, ls.p, Vec3::ZERO, Rgb::ONE);
         if !self.visible(&b, &lens) {
@@ -726,7 +730,13 @@ impl Sample<'_, '_> {
                 radiance += self.escaped(ray_dir, beta, pdf_dir);
                 break;
             };
-            let fwd = v.area_density(self.camera.v[i - 1].it.p, pdf_dir);
+            let fwd = if i == 1 && importance.directional() {
+                // One direction for every ray: the window's density,
+                // projected onto the surface.
+                pdf[0].pdf_pos * v.it.ng.dot(ray_dir).abs()
+            } else {
+                v.area_density(self.camera.v[i - 1].it.p, pdf_dir)
+            };
             self.camera.push(
                 v,
                 Mis {
