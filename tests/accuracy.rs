@@ -1,6 +1,8 @@
 //! The accuracy/time report on the default scene: error falls as 1/√spp
 //! for the scene as written, max_depth 2 is reported as biased, and the
-//! CSV, plot and summary are written and parse.
+//! CSV, plot and summary are written and parse; on the grid cloud against
+//! its Mitsuba file, a setting that renders without noise is still tested
+//! for bias, and an integrator that refuses the scene is a note.
 //!
 //! Every run is limited by spp caps far below its time limits, so the
 //! measurements (seeded, thread-count independent) are the same on a
@@ -139,7 +141,7 @@ fn max_depth_2_is_reported_as_biased() {
 }
 
 #[test]
-fn a_noise_free_setting_far_from_an_outside_reference_is_reported_as_biased() {
+fn the_cloud_against_its_mitsuba_file_flags_noise_free_bias_and_notes_refusals() {
     // On the grid cloud (a `null` cube around the medium, a sun and a
     // constant sky) max_depth 2 renders without noise: both halves agree
     // bit for bit, and the image is far from the reference. Against a
@@ -155,7 +157,7 @@ fn a_noise_free_setting_far_from_an_outside_reference_is_reported_as_biased() {
         max_spp: 16,
         // The reference's size, the scene's own (64×64).
         overrides: Overrides::default(),
-        ..config(&[Axis::MaxDepth])
+        ..config(&[Axis::MaxDepth, Axis::Integrator])
     };
     let registry = radiant::builtin_registry();
     let report = accuracy::run(&mut cloud, &registry, &c, Some(reference), &|line| {
@@ -181,6 +183,28 @@ fn a_noise_free_setting_far_from_an_outside_reference_is_reported_as_biased() {
     }
     // The scene as written (max_depth −1) matches Mitsuba's.
     assert!(!by_label("baseline").is_biased());
+    // bdpt refuses participating media: a note, and the other
+    // integrators are still measured (the refusal ended the report before).
+    assert!(
+        report
+            .notes
+            .iter()
+            .any(|n| n.starts_with("integrator=bdpt: not measured: ") && n.contains("media")),
+        "{:?}",
+        report.notes
+    );
+    assert!(
+        report
+            .curves
+            .iter()
+            .all(|c| c.setting.label() != "integrator=bdpt")
+    );
+    assert!(
+        report
+            .curves
+            .iter()
+            .any(|c| c.setting.label() == "integrator=pssmlt")
+    );
 }
 
 #[test]
