@@ -222,17 +222,27 @@ fn torture_scenes_render_finite_and_terminate_unlimited() {
 }
 
 #[test]
-fn unsupported_modules_are_refused_by_name() {
-    let text = std::fs::read_to_string(root().join("scenes/cornell-box.yaml")).expect("scene");
-    let text = with_integrator(&text, "{type: bdpt}").replacen(
-        "type: perspective",
-        "type: spherical\n  # fov: unused",
-        1,
+fn unsupported_features_are_refused_by_name() {
+    let path = root().join("scenes/media/fog-beam.yaml");
+    let text = std::fs::read_to_string(&path).expect("scene");
+    let text = with_integrator(&text, "{type: bdpt}");
+    let scene = radiant::scene::from_str(&text, &path, path.parent().expect("folder"))
+        .expect("scene parses");
+    let err = extract(&scene, &radiant::builtin_registry(), &Overrides::default())
+        .err()
+        .expect("bdpt refuses media");
+    let message = err.to_string();
+    assert!(
+        message.contains("`bdpt`") && message.contains("participating media"),
+        "{message}"
     );
-    let text = text
+    let dir = root().join("scenes");
+    // A camera without an importance side (spherical).
+    let text = std::fs::read_to_string(root().join("scenes/cornell-box.yaml")).expect("scene");
+    let text = with_integrator(&text, "{type: bdpt}")
+        .replacen("type: perspective", "type: spherical", 1)
         .replace("  fov: ", "  # fov: ")
         .replace("  fov_axis: ", "  # fov_axis: ");
-    let dir = root().join("scenes");
     let scene = radiant::scene::from_str(&text, std::path::Path::new("cornell.yaml"), &dir)
         .expect("scene parses");
     let err = extract(&scene, &radiant::builtin_registry(), &Overrides::default())
