@@ -11,6 +11,10 @@
 //! `scenes/media/cloud.yaml` and `scenes/media/jade.yaml`; regenerate them with
 //! `tests/reference/render_media.py` (its docstring has the commands).
 
+// `unwrap` in this test code is the assertion: the files it writes are the
+// test's own, in its temporary directory, so a failure is a bug (or a full
+// disk), and the panic reports it with the error.
+
 use glam::Vec3;
 use radiant::extract::Overrides;
 use radiant::film::Image;
