@@ -437,6 +437,9 @@ struct Tiler<'a> {
     integrator: &'a dyn TileIntegrator,
     /// The frame's splat film, where the integrator splats.
     splats: Option<&'a SplatFilm>,
+    /// Where adaptive sampling's decision samples splat (dropped): made
+    /// once per frame, for a splatting integrator under adaptive sampling.
+    decision_sink: Option<SplatFilm>,
     reconstruction: Reconstruction,
     samples: Range<u32>,
     /// Camera paths of the whole pass.
@@ -464,6 +467,9 @@ impl<'a> Tiler<'a> {
             scene,
             integrator,
             splats,
+            decision_sink: splats
+                .filter(|_| s.adaptive.is_some())
+                .map(|_| SplatFilm::sink(scene.filter.as_ref())),
             reconstruction: Reconstruction::new(scene.filter.as_ref(), reconstruction_of(s)),
             total: s.width as u64 * s.height as u64 * samples.len() as u64,
             samples,
@@ -573,11 +579,8 @@ impl<'a> Tiler<'a> {
         };
         if let Some(a) = &self.scene.settings.adaptive {
             let mut decisions = TileFilm::new(x0, y0, x1, y1, (w, h), self.reconstruction.reach());
-            let sink = self
-                .splats
-                .map(|_| SplatFilm::sink(self.scene.filter.as_ref()));
             let decision_ctx = TileContext {
-                splats: sink.as_ref(),
+                splats: self.decision_sink.as_ref(),
                 ..self.context()
             };
             let counts = adaptive::run_tile(a, self.samples.end, rect, |batch, decision, add| {
@@ -589,10 +592,12 @@ impl<'a> Tiler<'a> {
                     };
                     (&decision_ctx, out)
                 } else {
+                    // The image's samples decide nothing: no per-sample
+                    // report (`run_tile` passes a no-op for them).
                     let out = TileOutput {
                         film: &mut tile,
                         aovs: aovs.as_deref_mut(),
-                        samples: Some(add),
+                        samples: None,
                     };
                     (&ctx, out)
                 };

@@ -168,17 +168,10 @@ impl SplatFilm {
     /// The splats' exact sums at pixel (`x`, `y`) (r, g, b; the fourth is
     /// 0), for tests.
     pub fn sums_at(&self, x: u32, y: u32) -> Vec4 {
-        let row = self.rows[y as usize]
+        self.rows[y as usize]
             .lock()
-            .unwrap_or_else(|e| e.into_inner());
-        let s = row[x as usize];
-        let unit = (-f64::from(FRACTION_BITS)).exp2();
-        Vec4::new(
-            (s.0[0] as f64 * unit) as f32,
-            (s.0[1] as f64 * unit) as f32,
-            (s.0[2] as f64 * unit) as f32,
-            0.0,
-        )
+            .unwrap_or_else(|e| e.into_inner())[x as usize]
+            .to_f32()
     }
 }
 

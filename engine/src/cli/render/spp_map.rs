@@ -6,6 +6,7 @@
 use super::RenderArgs;
 use radiant::backend::{BackendKind, Progress, Written, cpu};
 use radiant::extract::RenderScene;
+use radiant::integrators::module::Family;
 use std::path::Path;
 
 /// Checks, before anything renders, that the map can be made as asked:
@@ -42,14 +43,20 @@ pub(super) fn write(
     progress: &Progress<'_>,
     note: &dyn Fn(&str),
 ) -> miette::Result<Written> {
-    let (rendered, counts) =
-        cpu::try_render_counted(scene, progress).map_err(|e| miette::miette!("{e}"))?;
-    let Some(counts) = counts else {
-        miette::bail!(
+    let chains = || {
+        miette::miette!(
             "--spp-map needs a tile integrator: `{}` runs Markov chains, with no samples per pixel",
             cpu::integrator_name(scene)
-        );
+        )
     };
+    // Refused before rendering: a chain integrator's frame would be
+    // rendered whole only to be dropped.
+    if matches!(scene.integrator.family(), Family::Chains(_)) {
+        return Err(chains());
+    }
+    let (rendered, counts) =
+        cpu::try_render_counted(scene, progress).map_err(|e| miette::miette!("{e}"))?;
+    let counts = counts.ok_or_else(chains)?;
     radiant::film::output::write_encoded(path, &rendered.image, &scene.settings.output)
         .map_err(|e| miette::miette!("{e}"))?;
     let most = counts.iter().copied().max().unwrap_or(0).max(1);
