@@ -108,11 +108,11 @@ impl LightTree {
             let (first, second) = (node + 1, n.index as usize);
             let p_first = self.first_probability(first, second, p)?;
             if u < p_first {
-                u = (u / p_first).min(ONE_BELOW);
+                u = (u / p_first).min(radiant_core::ONE_MINUS_EPSILON);
                 pmf *= p_first;
                 node = first;
             } else {
-                u = ((u - p_first) / (1.0 - p_first)).clamp(0.0, ONE_BELOW);
+                u = ((u - p_first) / (1.0 - p_first)).clamp(0.0, radiant_core::ONE_MINUS_EPSILON);
                 pmf *= 1.0 - p_first;
                 node = second;
             }
@@ -157,9 +157,6 @@ impl LightTree {
         (total > 0.0).then(|| a / total)
     }
 }
-
-/// The largest f32 below 1.
-const ONE_BELOW: f32 = 0.999_999_94;
 
 /// The bounds of two sets of lights together.
 fn union(a: &LightBounds, b: &LightBounds) -> LightBounds {

@@ -147,7 +147,7 @@ impl LightTable {
         };
         let share = 1.0 - self.p_unbounded;
         if let Some(tree) = &self.tree {
-            let v = ((u - self.p_unbounded) / share).clamp(0.0, 0.999_999_94);
+            let v = ((u - self.p_unbounded) / share).clamp(0.0, radiant_core::ONE_MINUS_EPSILON);
             return match tree.select(p, v) {
                 Some((slot, pmf)) => (self.bounded[slot].0 as usize, share * pmf),
                 None => (first as usize, 0.0),
@@ -261,7 +261,7 @@ impl LightTable {
         let lo = if i == 0 { 0.0 } else { self.cdf[i - 1] };
         let p = self.pmf[i];
         let rescaled = if p > 0.0 {
-            ((u - lo) / p).clamp(0.0, 0.999_999_94)
+            ((u - lo) / p).clamp(0.0, radiant_core::ONE_MINUS_EPSILON)
         } else {
             0.0
         };

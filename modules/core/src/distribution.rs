@@ -73,7 +73,7 @@ impl Distribution1D {
         let i = self.cdf.partition_point(|&c| c <= u).clamp(1, n) - 1;
         let width = self.cdf[i + 1] - self.cdf[i];
         let rest = if width > 0.0 {
-            ((u - self.cdf[i]) / width).clamp(0.0, 1.0 - f32::EPSILON / 2.0)
+            ((u - self.cdf[i]) / width).clamp(0.0, crate::ONE_MINUS_EPSILON)
         } else {
             0.5
         };

@@ -60,7 +60,7 @@ pub use light_bounds::LightBounds;
 pub use medium::{Coefficients, Medium, Phase, Profile};
 pub use params::{Color, Numbers, ParamError, Params, TextureInput};
 pub use registry::{ModuleInfo, ModuleKind, ParamDoc, Registry};
-pub use sampler::{SampleId, Sampler};
+pub use sampler::{ONE_MINUS_EPSILON, SampleId, Sampler};
 pub use shader::{
     BsdfEval, BsdfSample, Pooled, Scratch, ShadeContext, Shader, SurfaceBatch, estimate_albedo,
 };

@@ -4,6 +4,10 @@
 //! pixel `pixel` is a pure function of those and the scene seed. The
 //! integrator assigns dimensions per bounce so they stay decorrelated.
 
+/// The largest `f32` below 1: where a value meant to lie in [0, 1) is
+/// clamped after arithmetic that may round it up to 1.
+pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
 /// Identifies one pixel sample (a camera path).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct SampleId {

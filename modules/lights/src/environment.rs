@@ -593,7 +593,7 @@ mod tests {
         let i = cdf.partition_point(|&c| c <= u).clamp(1, n) - 1;
         let width = cdf[i + 1] - cdf[i];
         let rest = if width > 0.0 {
-            ((u - cdf[i]) / width).clamp(0.0, 0.999_999_94)
+            ((u - cdf[i]) / width).clamp(0.0, radiant_core::ONE_MINUS_EPSILON)
         } else {
             0.5
         };

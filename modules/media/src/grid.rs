@@ -114,11 +114,6 @@ impl DensityGrid {
     fn voxel(&self, x: usize, y: usize, z: usize) -> f32 {
         self.values[(z * self.resolution[1] + y) * self.resolution[0] + x]
     }
-
-    /// The largest value of the grid.
-    pub fn max(&self) -> f32 {
-        self.majorants.iter().copied().fold(0.0, f32::max)
-    }
 }
 
 /// The lower voxel index and weight of the upper one along an axis of `n`

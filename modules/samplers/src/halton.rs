@@ -89,7 +89,7 @@ fn owen_radical_inverse(mut index: u32, base: u32, key: u32) -> f32 {
         state = hash_u32(state ^ digit.wrapping_mul(0x9e37_79b9));
         scale *= inv_base;
     }
-    (sum as f32).min(1.0 - f32::EPSILON / 2.0)
+    (sum as f32).min(radiant_core::ONE_MINUS_EPSILON)
 }
 
 pointwise_sampler!(Halton);

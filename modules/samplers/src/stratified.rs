@@ -15,7 +15,7 @@ use crate::scramble::{SCRAMBLE_WGSL, permute};
 use crate::seed::fold;
 use radiant_core::glam::Vec2;
 use radiant_core::hash::{hash_u32, hash4, unit_float};
-use radiant_core::{GpuModule, GpuParams, Registry, SampleId};
+use radiant_core::{GpuModule, GpuParams, ONE_MINUS_EPSILON, Registry, SampleId};
 
 /// Jittered stratified sampling over `spp` samples per pixel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -96,9 +96,6 @@ impl Pointwise for Stratified {
         )
     }
 }
-
-/// The largest f32 below 1.
-const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
 pointwise_sampler!(Stratified);
 
