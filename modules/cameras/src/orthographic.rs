@@ -34,6 +34,8 @@ const DOCS: &[ParamDoc] = &[ParamDoc {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Orthographic {
     to_render: Mat4,
+    /// `to_render`'s inverse, for connections to the window.
+    to_camera: Mat4,
     raster: Raster,
     /// Half the window's extent along x and y.
     half: Vec2,
@@ -46,6 +48,7 @@ impl Orthographic {
         let half = Vec2::new(width, width * resolution.y / resolution.x) * 0.5;
         Ok(Self {
             to_render,
+            to_camera: to_render.inverse(),
             raster: Raster::new(resolution),
             half,
         })
@@ -63,13 +66,12 @@ impl Orthographic {
 /// 1 / window area (pbrt's convention for a delta direction).
 impl Importance for Orthographic {
     fn sample_wi(&self, refs: &[Vec3], _u: &[Vec2], out: &mut [LensSample]) {
-        let to_camera = self.to_render.inverse();
         let dir = self.direction();
         let area = 4.0 * self.half.x * self.half.y;
         let size = 2.0 / self.raster.scale();
         for (r, o) in refs.iter().zip(out.iter_mut()) {
             *o = LensSample::default();
-            let q = to_camera.transform_point3(*r);
+            let q = self.to_camera.transform_point3(*r);
             if q.z <= 0.0 {
                 continue;
             }
@@ -89,10 +91,9 @@ impl Importance for Orthographic {
     }
 
     fn pdf_ray(&self, rays: &[(Vec3, Vec3)], out: &mut [CameraRayPdf]) {
-        let to_camera = self.to_render.inverse();
         let area = 4.0 * self.half.x * self.half.y;
         for ((origin, _), o) in rays.iter().zip(out.iter_mut()) {
-            let q = to_camera.transform_point3(*origin);
+            let q = self.to_camera.transform_point3(*origin);
             let inside = q.x.abs() <= self.half.x && q.y.abs() <= self.half.y;
             *o = CameraRayPdf {
                 pdf_pos: if inside { 1.0 / area } else { 0.0 },

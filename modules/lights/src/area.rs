@@ -154,30 +154,39 @@ impl AreaLight {
     /// solid-angle density of the whole strategy for it.
     #[inline]
     fn sample_part(&self, part: usize, origin: Vec3, u: Vec2) -> (Vec3, Vec3, f32) {
-        let (p, n) = match self.parts[part] {
+        match self.parts[part] {
+            Part::Rectangle(rect) => {
+                if let Some(s) = rect.spherical(origin) {
+                    let pdf = self.part_probability(part) / s.solid_angle;
+                    return (s.sample(u), rect.n, pdf);
+                }
+            }
+            Part::Sphere(centre, r) => {
+                if let Some(cone) = Cone::new(centre, r, origin) {
+                    let (p, n) = cone.sample(centre, r, origin, u);
+                    return (p, n, self.part_probability(part) * cone.pdf());
+                }
+            }
+            Part::Triangle(..) => {}
+        }
+        let (p, n) = self.point_by_area(part, u);
+        (p, n, self.area_pdf(origin, p, n))
+    }
+
+    /// A point of part `part` (with its normal), uniform by area.
+    #[inline]
+    fn point_by_area(&self, part: usize, u: Vec2) -> (Vec3, Vec3) {
+        match self.parts[part] {
             Part::Triangle([a, b, c], n) => {
                 let bary = square_to_uniform_triangle(u);
                 (a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y, n)
             }
-            Part::Rectangle(rect) => match rect.spherical(origin) {
-                Some(s) => {
-                    let pdf = self.part_probability(part) / s.solid_angle;
-                    return (s.sample(u), rect.n, pdf);
-                }
-                None => (rect.point(u), rect.n),
-            },
-            Part::Sphere(centre, r) => match Cone::new(centre, r, origin) {
-                Some(cone) => {
-                    let (p, n) = cone.sample(centre, r, origin, u);
-                    return (p, n, self.part_probability(part) * cone.pdf());
-                }
-                None => {
-                    let n = square_to_uniform_sphere(u);
-                    (centre + n * r, n)
-                }
-            },
-        };
-        (p, n, self.area_pdf(origin, p, n))
+            Part::Rectangle(rect) => (rect.point(u), rect.n),
+            Part::Sphere(centre, r) => {
+                let n = square_to_uniform_sphere(u);
+                (centre + n * r, n)
+            }
+        }
     }
 
     /// Solid-angle density of sampling point `p` (normal `n`) of part
@@ -344,18 +353,7 @@ impl Emission for AreaLight {
     fn sample_emission(&self, u_pos: &[Vec2], u_dir: &[Vec2], out: &mut [EmissionSample]) {
         for ((up, ud), o) in u_pos.iter().zip(u_dir).zip(out.iter_mut()) {
             let (part, ux) = self.pick(up.x);
-            let u = Vec2::new(ux, up.y);
-            let (p, n) = match self.parts[part] {
-                Part::Triangle([a, b, c], n) => {
-                    let bary = square_to_uniform_triangle(u);
-                    (a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y, n)
-                }
-                Part::Rectangle(rect) => (rect.point(u), rect.n),
-                Part::Sphere(centre, r) => {
-                    let n = square_to_uniform_sphere(u);
-                    (centre + n * r, n)
-                }
-            };
+            let (p, n) = self.point_by_area(part, Vec2::new(ux, up.y));
             let (dir, pdf_dir) = cosine_direction(n, *ud);
             // The first primitive of the part (parts are consecutive).
             let primitive = self.part_of.partition_point(|&q| (q as usize) < part) as u32;
