@@ -137,7 +137,7 @@ impl AreaLight {
         let lo = if i == 0 { 0.0 } else { self.cdf[i - 1] };
         let width = self.cdf[i] - lo;
         let rescaled = if width > 0.0 {
-            ((target - lo) / width).clamp(0.0, 0.999_999_94)
+            ((target - lo) / width).clamp(0.0, radiant_core::ONE_MINUS_EPSILON)
         } else {
             0.0
         };
