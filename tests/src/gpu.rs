@@ -5,6 +5,7 @@
 //! CI has no GPU: `.ci/run` installs Mesa's lavapipe, on which these run.
 //! Without any adapter the tests fail, saying so.
 
+use crate::{Tolerances, check_against};
 use radiant::backend::cpu::{Progress, render};
 use radiant::backend::gpu::{BvhLayout, GpuBackend, GpuOptions};
 use radiant::extract::{Overrides, RenderScene, extract};
@@ -57,14 +58,45 @@ pub fn render_both_with_bvh(
 }
 
 fn render_both_on(gpu: &mut GpuBackend, scene: &str, overrides: &Overrides) -> (Image, Image) {
-    let r = extract_scene(scene, overrides);
+    render_extracted_on(gpu, scene, &extract_scene(scene, overrides))
+}
+
+/// The GPU's and the CPU's renders of the extracted scene `r` (called
+/// `name` in failures).
+pub fn render_extracted(name: &str, r: &RenderScene) -> (Image, Image) {
+    render_extracted_on(&mut backend(), name, r)
+}
+
+fn render_extracted_on(gpu: &mut GpuBackend, name: &str, r: &RenderScene) -> (Image, Image) {
     let gpu = gpu
-        .render(&r, &Progress::none())
-        .unwrap_or_else(|e| panic!("{scene}: the GPU render failed: {e}"));
+        .render(r, &Progress::none())
+        .unwrap_or_else(|e| panic!("{name}: the GPU render failed: {e}"));
     assert_eq!(
         gpu.invalid_samples, 0,
-        "{scene}: NaN or infinite GPU samples"
+        "{name}: NaN or infinite GPU samples"
     );
-    let cpu = render(&r, &Progress::none());
+    let cpu = render(r, &Progress::none());
     (gpu.image, cpu.image)
+}
+
+/// Checks that the GPU image matches the CPU one within `tolerances`
+/// (8×8-pixel blocks), and that a 2 % scale of the GPU image would not.
+pub fn assert_agrees(name: &str, (gpu, cpu): (Image, Image), tolerances: Tolerances) {
+    let check = check_against(&gpu, &cpu, 8);
+    eprintln!("{name}: {check:?}");
+    assert!(
+        tolerances.passes(&check),
+        "{name}: the GPU render differs from the CPU's: {check:?}"
+    );
+    for scale in [0.98f32, 1.02] {
+        let scaled = Image {
+            pixels: gpu.pixels.iter().map(|p| *p * scale).collect(),
+            ..gpu.clone()
+        };
+        let check = check_against(&scaled, &cpu, 8);
+        assert!(
+            !tolerances.passes(&check),
+            "{name}: a {scale}× energy error would go unnoticed: {check:?}"
+        );
+    }
 }

@@ -17,11 +17,13 @@ use radiant_core::glam::Vec3;
 
 /// One node: a light, or two children (the first right after the node).
 #[derive(Debug, Clone, Copy)]
-struct Node {
-    bounds: LightBounds,
+pub struct Node {
+    /// The union of the bounds of the node's lights.
+    pub bounds: LightBounds,
     /// Leaf: the light's slot. Interior: the second child's index.
-    index: u32,
-    leaf: bool,
+    pub index: u32,
+    /// Whether the node is one light.
+    pub leaf: bool,
 }
 
 /// A hierarchy over lights, addressed by their slot (0..n in the order
@@ -92,6 +94,17 @@ impl LightTree {
             leaf: false,
         };
         at
+    }
+
+    /// The nodes, root first (for backends that walk the tree themselves).
+    pub fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+
+    /// The branch bits from the root (bit d set: second child at depth d)
+    /// and the depth of the leaf of `slot`.
+    pub fn trail(&self, slot: usize) -> Option<(u64, u32)> {
+        self.trail.get(slot).copied()
     }
 
     /// Chooses a light slot for the shading point `p` with the uniform

@@ -45,6 +45,22 @@ pub struct LightTable {
     tree: Option<LightTree>,
 }
 
+/// What spatial selection chooses with ([`LightTable::spatial`]): the
+/// bounded lights in their order (light index and bounds), the unbounded
+/// lights, their share, and the tree over the bounded lights' slots where
+/// there are more than [`FLAT_LIMIT`].
+#[derive(Debug, Clone, Copy)]
+pub struct SpatialTables<'a> {
+    /// (light index, bounds) per slot.
+    pub bounded: &'a [(u32, LightBounds)],
+    /// Indices of the lights without bounds.
+    pub unbounded: &'a [u32],
+    /// The probability of choosing one of `unbounded`.
+    pub p_unbounded: f32,
+    /// The hierarchy over the slots of `bounded`.
+    pub tree: Option<&'a LightTree>,
+}
+
 impl LightTable {
     /// Builds the table; with [`LightSelection::Power`] lights are chosen in
     /// proportion to [`Light::power`] (uniformly if no light reports a
@@ -55,7 +71,7 @@ impl LightTable {
             .map(|l| {
                 let p = match selection {
                     // Spatial selection keeps power as its table for
-                    // `select` (the GPU backend's choice).
+                    // `select` (bdpt's choice of a light subpath's light).
                     LightSelection::Power | LightSelection::Spatial => l.power() as f64,
                     LightSelection::Uniform => 1.0,
                 };
@@ -125,6 +141,18 @@ impl LightTable {
     #[inline]
     pub fn is_spatial(&self) -> bool {
         self.selection == LightSelection::Spatial && self.lights.len() > 1
+    }
+
+    /// Spatial selection's tables, for backends that choose lights
+    /// themselves (the GPU's); `None` where the choice does not depend on
+    /// the shading point ([`is_spatial`](Self::is_spatial) is false).
+    pub fn spatial(&self) -> Option<SpatialTables<'_>> {
+        self.is_spatial().then(|| SpatialTables {
+            bounded: &self.bounded,
+            unbounded: &self.unbounded,
+            p_unbounded: self.p_unbounded,
+            tree: self.tree.as_ref(),
+        })
     }
 
     /// Chooses a light for the shading point `p` with the uniform sample

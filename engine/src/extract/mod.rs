@@ -32,7 +32,8 @@ mod modules;
 mod sequence;
 mod shapes;
 
-pub use lights::{FLAT_LIMIT, LightTable};
+pub use light_tree::{LightTree, Node as LightTreeNode};
+pub use lights::{FLAT_LIMIT, LightTable, SpatialTables};
 pub use media::MediaTable;
 pub use sequence::{FrameUpdate, Sequence, SequenceOptions};
 pub(crate) use shapes::BARYCENTRIC_UVS;

@@ -24,6 +24,7 @@ const WIDE_BVH: &str = include_str!("wgsl/cwbvh.wgsl");
 const PATH: &str = include_str!("wgsl/path.wgsl");
 const WAVEFRONT: &str = include_str!("wgsl/wavefront.wgsl");
 const HEADER: &str = include_str!("wgsl/header.wgsl");
+const LIGHT_SELECTION: &str = include_str!("wgsl/light_selection.wgsl");
 
 /// Features that select blocks of the kernel's own sources.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -44,6 +45,9 @@ pub struct Features {
     pub lights: bool,
     /// Surfaces that emit.
     pub area_lights: bool,
+    /// Lights chosen by their bounds' importance at the shading point
+    /// (`light_selection: spatial` with more than one light).
+    pub spatial_lights: bool,
     /// Lights at infinity that escaped rays see.
     pub environment: bool,
     /// Counting of traversal work (`--gpu-stats`).
@@ -71,6 +75,7 @@ impl Features {
             motion: geometry.motion,
             lights: !scene.lights.is_empty(),
             area_lights: modules.area_lights,
+            spatial_lights: scene.lights.is_spatial(),
             environment: modules.environment,
             stats: false,
             wavefront: false,
@@ -88,6 +93,7 @@ impl Features {
             "MOTION" => self.motion,
             "LIGHTS" => self.lights,
             "AREA_LIGHTS" => self.area_lights,
+            "SPATIAL_LIGHTS" => self.spatial_lights,
             "ENVIRONMENT" => self.environment,
             "STATS" => self.stats,
             "WIDE_BVH" => self.wide_bvh,
@@ -106,6 +112,7 @@ impl Features {
             ("motion blur", self.motion),
             ("next-event estimation", self.lights),
             ("area lights", self.area_lights),
+            ("spatial light selection", self.spatial_lights),
             ("environment", self.environment),
             ("filter splatting", self.splat),
             ("wavefront stages", self.wavefront),
@@ -169,6 +176,10 @@ impl Kernel {
         k.part(
             "the GPU backend's path integrator (wgsl/path.wgsl)",
             &preprocess(PATH, &features),
+        );
+        k.part(
+            "the GPU backend's light selection (wgsl/light_selection.wgsl)",
+            &preprocess(LIGHT_SELECTION, &features),
         );
         if features.wavefront {
             k.part(

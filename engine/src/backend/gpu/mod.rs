@@ -19,6 +19,7 @@ mod cwbvh;
 mod device;
 pub mod error;
 pub mod kernel;
+mod light_selection;
 pub mod modules;
 pub mod probe;
 pub mod timing;

@@ -19,7 +19,7 @@ const FILTER_RES: u32 = 64;
 
 /// Words of the header at the start of the parameter buffer (the `H_*`
 /// constants of `wgsl/path.wgsl`).
-const HEADER_WORDS: usize = 18;
+const HEADER_WORDS: usize = 19;
 
 /// One module type of a kind, as the kernel includes it.
 #[derive(Debug, Clone, PartialEq)]
@@ -254,7 +254,8 @@ impl Modules {
     }
 
     /// The lights' directory: (type, offset, delta, probability) per
-    /// light, then the CDF of the probabilities.
+    /// light, then the CDF of the probabilities, the lights at infinity,
+    /// and spatial selection's tables (`light_selection.rs`).
     fn lights(&mut self, scene: &RenderScene) -> Result<(), GpuError> {
         let table = &scene.lights;
         let mut entries = Vec::with_capacity(4 * table.len());
@@ -293,6 +294,11 @@ impl Modules {
         self.params[13] = table.environment().len() as u32;
         self.params
             .extend(table.environment().iter().map(|&i| i as u32));
+        // Spatial selection's tables (header word 18), where it is on.
+        if let Some(words) = super::light_selection::words(table, self.params.len()) {
+            self.params[18] = self.params.len() as u32;
+            self.params.extend(words);
+        }
         Ok(())
     }
 

@@ -18,3 +18,4 @@ const H_SPLAT: u32 = 14u;
 const H_SPLAT_SCALE: u32 = 15u;
 const H_SPLAT_REACH: u32 = 16u;
 const H_CAMERA_MOTION: u32 = 17u;
+const H_LIGHT_SELECTION: u32 = 18u;

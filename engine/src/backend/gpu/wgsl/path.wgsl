@@ -1,7 +1,7 @@
 // The `path` integrator as a megakernel: one invocation renders the
 // samples of one pixel, path by path, with the estimator and sampler
 // dimensions of integrators/path.rs (next-event estimation with MIS by the
-// power heuristic, lights chosen in proportion to power, Russian roulette
+// power heuristic, lights chosen by light_selection.wgsl, Russian roulette
 // on throughput without the 1/η² of refraction), and adds Σ w·L and Σ w
 // to its pixel (filter importance sampling: w = f/pdf).
 
@@ -126,13 +126,13 @@ fn select_light(u: f32) -> vec2f {
 //#if ENVIRONMENT
 // Radiance of the lights at infinity along the escaped direction `dir`,
 // MIS-weighted against light sampling (integrators/path.rs add_escaped).
-fn escaped_radiance(dir: vec3f, depth: u32, prev_pdf: f32) -> vec3f {
+fn escaped_radiance(origin: vec3f, dir: vec3f, depth: u32, prev_pdf: f32) -> vec3f {
     var sum = vec3f(0.0);
     let n = param_u32(H_ENVIRONMENT_COUNT);
     for (var k = 0u; k < n; k++) {
         let l = param_u32(param_u32(H_ENVIRONMENT) + k);
         let e = light_escaped(l, dir);
-        let pmf = bitcast<f32>(light_word(l, 3u));
+        let pmf = light_pmf_at(origin, l);
         sum += e.radiance * bsdf_hit_weight(depth, prev_pdf, pmf * e.pdf);
     }
     return sum;
@@ -190,7 +190,7 @@ fn start_path(px: u32, py: u32, index: u32, path: ptr<function, PathState>) -> f
 // Adds what the path's ray sees where it leaves the scene.
 fn add_escaped(path: ptr<function, PathState>) {
 //#if ENVIRONMENT
-    (*path).radiance += (*path).beta * escaped_radiance(normalize((*path).d), (*path).depth, (*path).prev_pdf);
+    (*path).radiance += (*path).beta * escaped_radiance((*path).o, normalize((*path).d), (*path).depth, (*path).prev_pdf);
 //#endif
 }
 
@@ -200,7 +200,7 @@ fn add_emitted(path: ptr<function, PathState>, it: Interaction) {
 //#if AREA_LIGHTS
     if it.emitter != NO_EMITTER {
         let e = light_hit(it.emitter, EmitterHit((*path).o, it.p, it.ng, it.emitter_prim));
-        let pmf = bitcast<f32>(light_word(it.emitter, 3u));
+        let pmf = light_pmf_at((*path).o, it.emitter);
         (*path).radiance += (*path).beta * e.radiance * bsdf_hit_weight((*path).depth, (*path).prev_pdf, pmf * e.pdf);
     }
 //#endif
@@ -221,15 +221,15 @@ struct LightConnection {
     value: vec3f,
 }
 
-// Next-event estimation at the path's hit `it`: a light in proportion to
-// power, a point on it, and the shadow ray towards it.
+// Next-event estimation at the path's hit `it`: a light (choose_light), a
+// point on it, and the shadow ray towards it.
 fn connect_light(pixel: u32, index: u32, path: PathState, it: Interaction, sp: ShadingPoint) -> LightConnection {
     let base = CAMERA_DIMS + path.depth * BOUNCE_DIMS;
     let none = LightConnection(vec3f(0.0), vec3f(0.0), vec3f(0.0));
     var light = 0u;
     var light_prob = 1.0;
     if param_u32(H_LIGHT_COUNT) > 1u {
-        let choice = select_light(sample_1d(pixel, index, base));
+        let choice = choose_light(it.p, sample_1d(pixel, index, base));
         light = u32(choice.x);
         light_prob = choice.y;
     }
