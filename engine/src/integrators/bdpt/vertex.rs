@@ -1,19 +1,17 @@
-//! Subpath vertices and what every strategy asks of them: BSDF values and
-//! densities in either direction, in world space, and the conversion of a
-//! solid-angle density into one per unit area at the vertex reached.
+//! Subpath vertices, the conversion of a solid-angle density into one per
+//! unit area at the vertex reached, and the storage of a chunk's subpaths
+//! (one fixed-length row of vertices per camera sample).
 
 use super::mis::Mis;
-use crate::extract::RenderScene;
 use crate::integrators::surface::{Derivatives, Interaction};
 use glam::{Vec2, Vec3};
-use radiant_core::{
-    BsdfEval, BsdfSample, Effects, EmissionKind, Frame, Rgb, ShadeContext, SurfaceBatch,
-};
+use radiant_core::{EmissionKind, Frame, Rgb};
 
 /// What a vertex lies on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub(super) enum Kind {
     /// The lens (a camera subpath's first vertex).
+    #[default]
     Camera,
     /// A light (a light subpath's first vertex), emitting as `EmissionKind`.
     Light(EmissionKind),
@@ -21,8 +19,7 @@ pub(super) enum Kind {
     Surface,
 }
 
-/// One vertex of a subpath (the structure of arrays would gain nothing:
-/// a subpath is walked and connected one vertex at a time).
+/// One vertex of a subpath.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Vertex {
     /// What it lies on.
@@ -38,6 +35,15 @@ pub(super) struct Vertex {
     pub wo: Vec3,
     /// Throughput up to the vertex, its own scattering excluded.
     pub beta: Rgb,
+    /// Whether it is a surface whose material has a smooth lobe
+    /// (connections can reach it).
+    pub connectable: bool,
+}
+
+impl Default for Vertex {
+    fn default() -> Self {
+        Self::point(Kind::Camera, Vec3::ZERO, Vec3::ZERO, Rgb::ZERO)
+    }
 }
 
 impl Vertex {
@@ -56,6 +62,7 @@ impl Vertex {
             material: 0,
             wo: Vec3::ZERO,
             beta,
+            connectable: false,
         }
     }
 
@@ -86,103 +93,61 @@ impl Vertex {
     }
 }
 
-/// Shading calls on single vertices, with the scene's textures.
-pub(super) struct Shading<'a> {
-    scene: &'a RenderScene,
-    ctx: ShadeContext<'a>,
-}
-
-impl<'a> Shading<'a> {
-    /// Shading for `scene`.
-    pub(super) fn new(scene: &'a RenderScene) -> Self {
-        Self {
-            scene,
-            ctx: ShadeContext::new(&scene.textures),
-        }
-    }
-
-    /// The one-point surface batch of `v` seen from `wo` (world).
-    fn call<R>(
-        &mut self,
-        v: &Vertex,
-        wo: Vec3,
-        f: impl FnOnce(&dyn radiant_core::Shader, &mut ShadeContext<'a>, SurfaceBatch<'_>) -> R,
-    ) -> R {
-        let shader = self.scene.shaders[v.material as usize].as_ref();
-        let frame = &v.it.frame;
-        let wo = [frame.to_local(wo)];
-        let uv = [v.it.uv];
-        let du = [frame.to_local(v.derivs.dp_du)];
-        let dv = [frame.to_local(v.derivs.dp_dv)];
-        let mut batch = SurfaceBatch::new(&wo, &uv);
-        if shader.effects().contains(Effects::TANGENT_FRAMES) {
-            batch.dp_du = &du;
-            batch.dp_dv = &dv;
-        }
-        f(shader, &mut self.ctx, batch)
-    }
-
-    /// f(wo, wi) · |cos θi| and the density of `wi` given `wo` (world
-    /// directions, away from the surface).
-    pub(super) fn eval(&mut self, v: &Vertex, wo: Vec3, wi: Vec3) -> BsdfEval {
-        let local = [v.it.frame.to_local(wi)];
-        let mut out = [BsdfEval::default()];
-        self.call(v, wo, |s, ctx, batch| s.eval(ctx, batch, &local, &mut out));
-        out[0]
-    }
-
-    /// A sampled direction given `wo` (world), with `wi` in world space.
-    pub(super) fn sample(&mut self, v: &Vertex, wo: Vec3, u: [f32; 3]) -> BsdfSample {
-        let u = [Vec3::from(u)];
-        let mut out = [BsdfSample::default()];
-        self.call(v, wo, |s, ctx, batch| s.sample(ctx, batch, &u, &mut out));
-        let mut s = out[0];
-        s.wi = v.it.frame.to_world(s.wi);
-        s
-    }
-
-    /// The albedo of `v`'s material seen from `v.wo` (for the output
-    /// variables).
-    pub(super) fn albedo(&mut self, v: &Vertex) -> Rgb {
-        let mut out = [Rgb::ZERO];
-        self.call(v, v.wo, |s, ctx, batch| s.albedo(ctx, batch, &mut out));
-        out[0]
-    }
-
-    /// Whether `v`'s material has a smooth lobe (connections can reach it).
-    pub(super) fn connectable(&self, v: &Vertex) -> bool {
-        v.kind == Kind::Surface
-            && self.scene.shaders[v.material as usize]
-                .effects()
-                .contains(Effects::SMOOTH_LOBES)
-    }
-}
-
-/// A subpath: its vertices and their MIS state, reused from sample to
-/// sample (cleared, never shrunk).
+/// One kind of subpath (camera or light) of every sample of a chunk: row
+/// `j` holds sample `j`'s vertices and their MIS state, `stride` of them
+/// at most. Reused from chunk to chunk (never shrunk).
 #[derive(Default)]
-pub(super) struct Subpath {
-    /// The vertices.
-    pub v: Vec<Vertex>,
-    /// Their MIS state.
-    pub mis: Vec<Mis>,
+pub(super) struct Subpaths {
+    stride: usize,
+    v: Vec<Vertex>,
+    mis: Vec<Mis>,
+    len: Vec<u32>,
 }
 
-impl Subpath {
-    /// Empties the subpath, keeping its memory.
-    pub(super) fn clear(&mut self) {
-        self.v.clear();
-        self.mis.clear();
+impl Subpaths {
+    /// Empties the rows of `n` samples of at most `stride` vertices.
+    pub(super) fn reset(&mut self, n: usize, stride: usize) {
+        self.stride = stride;
+        if self.v.len() < n * stride {
+            self.v.resize(n * stride, Vertex::default());
+            self.mis.resize(n * stride, Mis::default());
+        }
+        self.len.clear();
+        self.len.resize(n, 0);
     }
 
-    /// Appends a vertex.
-    pub(super) fn push(&mut self, v: Vertex, mis: Mis) {
-        self.v.push(v);
-        self.mis.push(mis);
+    /// Appends a vertex to sample `j`'s row.
+    #[inline]
+    pub(super) fn push(&mut self, j: usize, v: Vertex, mis: Mis) {
+        let at = j * self.stride + self.len[j] as usize;
+        self.v[at] = v;
+        self.mis[at] = mis;
+        self.len[j] += 1;
     }
 
-    /// Number of vertices.
-    pub(super) fn len(&self) -> usize {
-        self.v.len()
+    /// Number of vertices of sample `j`.
+    #[inline]
+    pub(super) fn len(&self, j: usize) -> usize {
+        self.len[j] as usize
+    }
+
+    /// Vertex `k` of sample `j`.
+    #[inline]
+    pub(super) fn at(&self, j: usize, k: usize) -> &Vertex {
+        &self.v[j * self.stride + k]
+    }
+
+    /// The MIS state of sample `j`'s vertices 0 ..= `k`.
+    #[inline]
+    pub(super) fn mis(&self, j: usize, k: usize) -> &[Mis] {
+        let a = j * self.stride;
+        &self.mis[a..=a + k]
+    }
+
+    /// The MIS state of sample `j`'s vertices 0 ..= `k`, to complete.
+    #[inline]
+    pub(super) fn mis_mut(&mut self, j: usize, k: usize) -> &mut [Mis] {
+        let a = j * self.stride;
+        &mut self.mis[a..=a + k]
     }
 }
