@@ -37,6 +37,8 @@ The committed reference ``tests/data/media-smoke-mitsuba.exr`` was made with
         --spp 8192 --pass-spp 1024 --out tests/data/media-cloud-mitsuba.exr
     nice -n 10 python3 tests/reference/render_media.py --scene jade \\
         --spp 4096 --pass-spp 512 --out tests/data/media-jade-mitsuba.exr
+    nice -n 10 python3 tests/reference/render_media.py --scene cloud --max-depth 2 \\
+        --spp 8192 --pass-spp 1024 --out tests/data/media-cloud-depth2-mitsuba.exr
 
 ``--scene jade``: ``scenes/media/jade.yaml``, random-walk subsurface
 scattering: a dielectric sphere around a dense scattering medium, under a
@@ -59,10 +61,10 @@ RADIUS = 0.38
 SIZE = 64
 
 
-def smoke_scene(mi):
+def smoke_scene(mi, max_depth=-1):
     """mi.cornell_box() at SIZE x SIZE with the smoke sphere and volpath."""
     desc = mi.cornell_box()
-    desc["integrator"] = {"type": "volpath", "max_depth": -1, "rr_depth": 5}
+    desc["integrator"] = {"type": "volpath", "max_depth": max_depth, "rr_depth": 5}
     film = desc["sensor"]["film"]
     film["width"] = SIZE
     film["height"] = SIZE
@@ -87,12 +89,12 @@ def smoke_scene(mi):
     return mi.load_dict(desc)
 
 
-def dark_scene(mi):
+def dark_scene(mi, max_depth=-1):
     """A grey HG smoke sphere and a spherical light, no other geometry."""
     T = mi.ScalarTransform4f
     return mi.load_dict({
         "type": "scene",
-        "integrator": {"type": "volpath", "max_depth": -1, "rr_depth": 5},
+        "integrator": {"type": "volpath", "max_depth": max_depth, "rr_depth": 5},
         "sensor": {
             "type": "perspective",
             "fov": 30,
@@ -120,7 +122,7 @@ def dark_scene(mi):
     })
 
 
-def beam_scene(mi):
+def beam_scene(mi, max_depth=-1):
     """scenes/media/fog-beam.yaml: a spot light's beam in a global fog."""
     T = mi.ScalarTransform4f
     fog = {
@@ -131,7 +133,7 @@ def beam_scene(mi):
     }
     return mi.load_dict({
         "type": "scene",
-        "integrator": {"type": "volpath", "max_depth": -1, "rr_depth": 5},
+        "integrator": {"type": "volpath", "max_depth": max_depth, "rr_depth": 5},
         "sensor": {
             "type": "perspective",
             "fov": 50,
@@ -191,13 +193,13 @@ def write_cloud(np):
     print(f"wrote {CLOUD_VOL}: max {d.max():.3f}, mean {d.mean():.3f}", file=sys.stderr)
 
 
-def cloud_scene(mi):
+def cloud_scene(mi, max_depth=-1):
     """scenes/media/cloud.yaml: the grid cloud, a sun and a sky."""
     T = mi.ScalarTransform4f
     top = CLOUD_SIGMA_S + CLOUD_SIGMA_A
     return mi.load_dict({
         "type": "scene",
-        "integrator": {"type": "volpath", "max_depth": -1, "rr_depth": 5},
+        "integrator": {"type": "volpath", "max_depth": max_depth, "rr_depth": 5},
         "sensor": {
             "type": "perspective",
             "fov": 45,
@@ -224,7 +226,7 @@ def cloud_scene(mi):
     })
 
 
-def jade_scene(mi):
+def jade_scene(mi, max_depth=-1):
     """scenes/media/jade.yaml: random-walk subsurface scattering in a
     dielectric sphere."""
     T = mi.ScalarTransform4f
@@ -233,7 +235,7 @@ def jade_scene(mi):
     top = max(sigma_t)
     return mi.load_dict({
         "type": "scene",
-        "integrator": {"type": "volpath", "max_depth": -1, "rr_depth": 5},
+        "integrator": {"type": "volpath", "max_depth": max_depth, "rr_depth": 5},
         "sensor": {
             "type": "perspective",
             "fov": 30,
@@ -267,6 +269,8 @@ def main():
     ap.add_argument("--spp", type=int, default=1024)
     ap.add_argument("--pass-spp", type=int, default=1024)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--max-depth", type=int, default=-1,
+                    help="volpath's max_depth (-1: unlimited); null crossings do not count")
     ap.add_argument("--out", required=True, help="output .exr file")
     args = ap.parse_args()
 
@@ -279,7 +283,7 @@ def main():
         write_cloud(np)
     scenes = {"smoke": smoke_scene, "dark": dark_scene, "beam": beam_scene, "cloud": cloud_scene,
               "jade": jade_scene}
-    scene = scenes[args.scene](mi)
+    scene = scenes[args.scene](mi, args.max_depth)
     accum = np.zeros((SIZE, SIZE, 3), dtype=np.float64)
     done = 0
     i = 0

@@ -33,9 +33,14 @@
 //!    medium as it is), and keeps, across `null` crossings, the last real
 //!    vertex and its direction density, which MIS of emitter hits needs.
 //!
-//! A `null` crossing counts as a bounce (all paths of a batch are at the
-//! same depth), so `max_depth` counts it as Mitsuba's `volpath` does not;
-//! scenes with media should leave `max_depth` unlimited or generous.
+//! A `null` crossing does not use up a bounce (Mitsuba 3's `volpath`):
+//! each path keeps its own depth, the number of its real scattering
+//! vertices (surfaces other than `null`, medium events), which `max_depth`
+//! and `rr_depth` compare against ([`MediumState::retire`],
+//! [`MediumState::depth`]). So that paths end in degenerate scenes, a path
+//! crosses at most [`MAX_CROSSINGS`] `null` boundaries, the bound shadow
+//! rays have too; the next crossing ends it (its light is lost, as a shadow
+//! ray's is).
 
 use super::surface::{Interaction, interaction};
 use crate::accel::Hit;
@@ -51,8 +56,9 @@ use radiant_core::{BsdfEval, BsdfSample, Coefficients, Frame, Profile, Rgb, Samp
 /// Sampler dimensions a bounce uses in scenes with media, after the
 /// surface's own: the hero channel and the distance.
 pub const MEDIUM_DIMS: u32 = 2;
-/// `null` boundaries a shadow ray may pass before it counts as blocked.
-const MAX_CROSSINGS: u32 = 256;
+/// `null` boundaries a path or a shadow ray may cross: a shadow ray
+/// meeting one more counts as blocked, a path meeting one more ends.
+pub const MAX_CROSSINGS: u32 = 256;
 
 /// Per-slot medium state of a wavefront and its scratch buffers.
 #[derive(Default)]
@@ -66,6 +72,10 @@ pub struct MediumState {
     scatter_origin: Vec<Vec3>,
     /// The direction density sampled there (0: a delta lobe).
     scatter_pdf: Vec<f32>,
+    /// Real scattering vertices so far (`null` crossings left out).
+    depth: Vec<u32>,
+    /// `null` boundaries crossed so far.
+    crossings: Vec<u32>,
     /// Slots that scattered in a medium this bounce.
     events: Vec<u32>,
     // Scratch per live path.
@@ -88,6 +98,41 @@ impl MediumState {
         self.scatter_origin.extend_from_slice(origins);
         self.scatter_pdf.clear();
         self.scatter_pdf.resize(n, 0.0);
+        self.depth.clear();
+        self.depth.resize(n, 0);
+        self.crossings.clear();
+        self.crossings.resize(n, 0);
+    }
+
+    /// Each slot's path depth: its real scattering vertices so far.
+    #[inline]
+    pub fn depth(&self) -> &[u32] {
+        &self.depth
+    }
+
+    /// Ends the paths of `live` (after the surface hits are resolved and
+    /// the events rejoined) that may not scatter again: a vertex of a path
+    /// at depth d is its (d + 1)-th, allowed while d + 1 < `max_depth`; a
+    /// `null` crossing is allowed while the path has crossed fewer than
+    /// [`MAX_CROSSINGS`]. Returns whether it ended any.
+    pub fn retire(
+        &self,
+        scene: &RenderScene,
+        live: &mut Vec<u32>,
+        hits: &[Hit],
+        max_depth: u32,
+    ) -> bool {
+        let before = live.len();
+        let null = &scene.media.null;
+        live.retain(|&slot| {
+            let i = slot as usize;
+            if !self.event[i] && null[scene.material(&hits[i]) as usize] {
+                self.crossings[i] < MAX_CROSSINGS
+            } else {
+                self.depth[i] + 1 < max_depth
+            }
+        });
+        live.len() != before
     }
 
     /// Where the light densities of `slot`'s emitter hits are measured
@@ -324,7 +369,8 @@ impl MediumState {
     /// After the continuation of the surviving paths `live` (new directions
     /// in `dir`): paths leaving a medium interface enter the medium on the
     /// side they head to; across `null` crossings the last real vertex and
-    /// its direction density (`prev_pdf`) are kept for MIS.
+    /// its direction density (`prev_pdf`) are kept for MIS, and the path's
+    /// depth stays (its crossings grow).
     pub fn after_bounce(
         &mut self,
         scene: &RenderScene,
@@ -343,9 +389,11 @@ impl MediumState {
                     media.after_crossing(material, self.medium[i], dir[i].dot(its[i].ng));
                 if media.null[material as usize] {
                     prev_pdf[i] = self.scatter_pdf[i];
+                    self.crossings[i] += 1;
                     continue;
                 }
             }
+            self.depth[i] += 1;
             self.scatter_origin[i] = its[i].p;
             self.scatter_pdf[i] = prev_pdf[i];
         }

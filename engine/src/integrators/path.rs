@@ -454,6 +454,9 @@ impl Wavefront {
         if has_media {
             self.media.start(scene, &self.origin[..self.live.len()]);
         }
+        // Segments traced so far: every path's depth where there are no
+        // `null` boundaries; with them each path keeps its own depth
+        // (`MediumState::depth`).
         let mut depth = 0u32;
         while !self.live.is_empty() {
             let base = camera_dims + depth * bounce_dims;
@@ -477,17 +480,9 @@ impl Wavefront {
             if has_env {
                 self.add_escaped(scene, depth);
             }
-            let first_hits = depth == 0 && self.collect_aovs;
-            if depth + 1 >= max_depth && !first_hits {
+            let Some(n) = self.select_vertices(scene, depth, max_depth, has_media) else {
                 break;
-            }
-            let n = self.sort_by_material(scene);
-            if first_hits {
-                self.record_first_hits(scene, n);
-                if depth + 1 >= max_depth {
-                    break;
-                }
-            }
+            };
             if has_lights {
                 self.sample_lights(scene, sampler, n, base);
             }
@@ -506,7 +501,7 @@ impl Wavefront {
             if has_lights {
                 self.next_event(scene, n);
             }
-            self.continue_paths(scene, sampler, depth, base);
+            self.continue_paths(scene, sampler, depth, has_media, base);
             if has_media {
                 self.media.after_bounce(
                     scene,
@@ -518,6 +513,40 @@ impl Wavefront {
             }
             depth += 1;
         }
+    }
+
+    /// Ends the paths whose hit may not scatter (`max_depth`; per path
+    /// where `null` boundaries may be crossed, see `integrators/medium.rs`)
+    /// and sorts the rest by material — after recording the camera rays'
+    /// first hits when the batch collects them, `segment` 0. `None` when no
+    /// path goes on.
+    fn select_vertices(
+        &mut self,
+        scene: &RenderScene,
+        segment: u32,
+        max_depth: u32,
+        has_media: bool,
+    ) -> Option<usize> {
+        let mut sorted = None;
+        if segment == 0 && self.collect_aovs {
+            let n = self.sort_by_material(scene);
+            self.record_first_hits(scene, n);
+            sorted = Some(n);
+        }
+        if has_media {
+            if self
+                .media
+                .retire(scene, &mut self.live, &self.hit, max_depth)
+            {
+                sorted = None;
+            }
+        } else if segment + 1 >= max_depth {
+            return None;
+        }
+        if self.live.is_empty() {
+            return None;
+        }
+        Some(sorted.unwrap_or_else(|| self.sort_by_material(scene)))
     }
 
     fn trace_closest(&mut self, scene: &RenderScene) {
@@ -952,18 +981,23 @@ impl Wavefront {
         self.rays += self.shadow_slot.len() as u64;
     }
 
-    /// Follows the BSDF samples, applies Russian roulette and compacts.
+    /// Follows the BSDF samples, applies Russian roulette (from
+    /// `rr_depth` on: the batch's `depth`, or each path's own where
+    /// `null` boundaries may be crossed, `per_path`) and compacts.
     fn continue_paths(
         &mut self,
         scene: &RenderScene,
         sampler: &dyn Sampler,
         depth: u32,
+        per_path: bool,
         base: u32,
     ) {
         let n = self.live.len();
         fit(&mut self.u1, n);
         sampler.fill_1d(&self.ids_k, base + 6, &mut self.u1);
-        let rr = depth + 1 >= scene.settings.rr_depth;
+        let rr_depth = scene.settings.rr_depth;
+        let rr_all = depth + 1 >= rr_depth;
+        let depths = per_path.then(|| self.media.depth());
         fit(&mut self.next_live, n);
         // Slices taken once (bounds in registers); survivors written by
         // count.
@@ -1000,6 +1034,7 @@ impl Wavefront {
             // at random, so it gathers no 1/q^k weight.
             let eta_scale = eta_of[i] * s.eta * s.eta;
             let survival = beta_max * eta_scale;
+            let rr = depths.map_or(rr_all, |d| d[i] + 1 >= rr_depth);
             if rr && survival < 1.0 {
                 if u[k] >= survival {
                     continue;
