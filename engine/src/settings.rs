@@ -84,14 +84,16 @@ pub enum FilterSampling {
 #[serde(rename_all = "lowercase")]
 pub enum LightSelection {
     /// In proportion to each light's emitted power.
-    #[default]
     Power,
     /// Every light equally likely.
     Uniform,
     /// By each light's importance at the shading point — its power over
     /// the squared distance, zero outside its emission cone (pbrt-v4's
     /// light bounds, after Conty and Kulla 2018); lights at infinity take
-    /// a fixed share.
+    /// a fixed share. The default: the CPU and the GPU choose alike
+    /// (`backend/gpu/wgsl/light_selection.wgsl`), and with unequal lights
+    /// it is far less noisy than power (`engine/benches/SUITE.md`).
+    #[default]
     Spatial,
 }
 

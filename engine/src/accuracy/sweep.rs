@@ -540,8 +540,8 @@ mod tests {
                 "sampler=halton",
                 "sampler=sobol",
                 "sampler=stratified",
-                "light_selection=uniform",
-                "light_selection=spatial"
+                "light_selection=power",
+                "light_selection=uniform"
             ]
         );
         assert!(notes.is_empty());
@@ -553,7 +553,7 @@ mod tests {
                 .unwrap();
             let expected = match s.change {
                 Change::LightSelection(l) => l,
-                _ => LightSelection::Power,
+                _ => LightSelection::Spatial,
             };
             assert_eq!(r.settings.light_selection, expected);
         }

@@ -2,7 +2,8 @@
 //!
 //! Unidirectional path tracing with next-event estimation at every vertex
 //! with a non-delta lobe, multiple importance sampling (power heuristic)
-//! between BSDF and light sampling, lights chosen in proportion to power,
+//! between BSDF and light sampling, lights chosen by `light_selection`
+//! (by their bounds' importance at the shading point by default),
 //! and Russian roulette driven by path throughput from `rr_depth` on —
 //! the estimator of Mitsuba 3's `path` integrator, with the same
 //! `max_depth` semantics (1 = emitters seen directly, 2 = direct light, …).
@@ -793,7 +794,7 @@ impl Wavefront {
         }
     }
 
-    /// Chooses a light per path in proportion to power and samples the
+    /// Chooses a light per path (`LightTable::select_at`) and samples the
     /// chosen lights, one module call per light.
     fn sample_chosen_lights(
         &mut self,

@@ -187,7 +187,7 @@ pub const SCENE_KEYS: &[KeyDocs] = &[
             key(
                 "light_selection",
                 "power | uniform | spatial",
-                "power",
+                "spatial",
                 "How next-event estimation picks a light: by power, uniformly, or by importance at the shading point.",
             ),
         ],

@@ -3,7 +3,7 @@
 //! A scene file is a mapping with these keys (all optional but `camera`):
 //!
 //! ```yaml
-//! integrator: {type: path, max_depth: 8, rr_depth: 5, light_selection: power}
+//! integrator: {type: path, max_depth: 8, rr_depth: 5, light_selection: spatial}
 //! film: {width: 256, height: 256, filter: {type: gaussian, stddev: 0.5}}
 //! sampler: {type: independent, spp: 64}
 //! camera: {type: perspective, fov: 40, look_at: {origin: [0, 0, 4], target: [0, 0, 0], up: [0, 1, 0]}}
