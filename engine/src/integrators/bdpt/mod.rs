@@ -110,8 +110,8 @@ pub fn check(scene: &RenderScene) -> Result<(), String> {
             .map_or("?", |(_, n)| n.as_str());
         return Err(format!(
             "`bdpt` connects light paths to the camera, and the camera type `{camera}` has no \
-             importance side (`Camera::importance`); use `perspective`, `thin_lens` or \
-             `orthographic`, or the `path` integrator"
+             importance side (`Camera::importance`); use `perspective`, `thin_lens`, \
+             `orthographic` or `spherical`, or the `path` integrator"
         ));
     }
     for (i, light) in scene.lights.lights().iter().enumerate() {
