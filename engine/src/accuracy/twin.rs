@@ -2,10 +2,12 @@
 //! seeds, over one extracted scene: the halves whose difference measures
 //! the noise (see [`metrics`](super::metrics)). On the `denoise` axis each
 //! half also collects its first-hit planes and is denoised when developed.
-//! An integrator or adaptive sampling that does not render in passes
-//! ([`cpu::passes`](crate::backend::cpu::passes)) is measured by whole
-//! renders instead: each point renders both halves afresh with all its
-//! samples, and its time is that render's.
+//! An integrator that does not render in passes
+//! ([`cpu::passes`](crate::backend::cpu::passes)), and adaptive sampling
+//! (whose passes render shares of each pixel's count in a render of the
+//! scene's spp, where a point of the curve is an adaptive render of that
+//! point's spp), are measured by whole renders instead: each point renders
+//! both halves afresh with all its samples, and its time is that render's.
 
 use super::metrics::Halves;
 use crate::backend::cpu::{self, Progress, render_samples, render_samples_with_aovs};
@@ -141,7 +143,7 @@ impl TwinRender {
     /// Measures by whole renders where the scene does not render in
     /// passes (see the module documentation).
     pub fn whole_renders_where_needed(&mut self) {
-        if cpu::passes(&self.scene).is_err() {
+        if cpu::passes(&self.scene).is_err() || self.scene.settings.adaptive.is_some() {
             let (w, h) = (self.scene.settings.width, self.scene.settings.height);
             let black = || Image {
                 width: w,

@@ -26,7 +26,6 @@ use crate::integrators::module::batches;
 use crate::integrators::{
     ChainContext, Family, SplatFilm, TileContext, TileIntegrator, TileOutput, TileWorker,
 };
-use crate::settings::FilterSampling;
 use radiant_core::Rgb;
 use rayon::prelude::*;
 use std::ops::Range;
@@ -170,8 +169,9 @@ fn add_splats(splats: Option<&SplatFilm>, image: &mut Image, samples: u64) -> u6
 }
 
 /// The tile integrator of `scene` where it renders in passes of sample
-/// ranges — a tile integrator that does not splat, without adaptive
-/// sampling — or why it cannot: `--time`, `--checkpoint`, `--resume` and
+/// ranges — a tile integrator that does not splat (under adaptive
+/// sampling, passes render shares of each pixel's count, see
+/// [`adaptive::pass_share`]) — or why it cannot: `--time`, `--checkpoint`, `--resume` and
 /// `--partition` render in passes, and the banded writer needs the same.
 pub fn passes(scene: &RenderScene) -> Result<&dyn TileIntegrator, RenderError> {
     let refuse = |why: &str| {
@@ -188,9 +188,6 @@ pub fn passes(scene: &RenderScene) -> Result<&dyn TileIntegrator, RenderError> {
         Family::Tiles(t) if t.splats() => refuse(&format!(
             "the integrator `{name}` splats light paths over the whole image"
         )),
-        Family::Tiles(_) if scene.settings.adaptive.is_some() => {
-            refuse("adaptive sampling decides per pixel over the whole render")
-        }
         Family::Tiles(t) => Ok(t),
     }
 }
@@ -270,12 +267,58 @@ pub fn render_samples_with_aovs(
     progress: &Progress<'_>,
 ) -> Pass {
     let tiles = passes(scene).unwrap_or_else(|e| panic!("{e}"));
-    Tiler::new(scene, tiles, None, samples, progress).whole(Tiler::render_aovs, |tiles| {
+    let decided = film_decisions(scene, tiles, film);
+    let mut tiler = Tiler::new(scene, tiles, None, samples, progress);
+    tiler.decided = decided.as_deref();
+    let pass = tiler.whole(Tiler::render_aovs, |tiles| {
         for (tile, aov) in tiles {
             film.merge(tile);
             aovs.merge(aov);
         }
-    })
+    });
+    film.adaptive_counts = decided;
+    pass
+}
+
+/// Under adaptive sampling, the image samples each pixel of the frame
+/// takes, from `film` where an earlier pass decided them, else decided
+/// now (all tiles, on the pool's threads); `None` without adaptive
+/// sampling. The caller puts them back in the film after the pass.
+fn film_decisions(
+    scene: &RenderScene,
+    tiles: &dyn TileIntegrator,
+    film: &mut Film,
+) -> Option<Vec<u32>> {
+    let a = scene.settings.adaptive.as_ref()?;
+    if let Some(counts) = film.adaptive_counts.take() {
+        return Some(counts);
+    }
+    let s = &scene.settings;
+    let none = Progress::none();
+    let tiler = Tiler::new(scene, tiles, None, 0..s.spp, &none);
+    let columns = s.width.div_ceil(TILE);
+    let origins: Vec<(u32, u32)> = (0..s.height.div_ceil(TILE))
+        .flat_map(|ty| (0..columns).map(move |tx| (tx * TILE, ty * TILE)))
+        .collect();
+    let decided: Vec<(TileRect, Vec<u32>)> = origins
+        .par_iter()
+        .map_init(
+            || tiles.worker(),
+            |worker, &origin| {
+                let rect = tiler.rect(origin);
+                (rect, tiler.decide(worker.as_mut(), a, rect))
+            },
+        )
+        .collect();
+    let mut frame = vec![0u32; s.width as usize * s.height as usize];
+    for (t, counts) in decided {
+        let tw = (t.x1 - t.x0) as usize;
+        for (row, y) in counts.chunks(tw.max(1)).zip(t.y0..) {
+            let start = (y * t.width + t.x0) as usize;
+            frame[start..start + row.len()].copy_from_slice(row);
+        }
+    }
+    Some(frame)
 }
 
 /// Renders `scene` on all threads of the current rayon pool and writes the
@@ -360,8 +403,12 @@ pub fn render_samples(
     progress: &Progress<'_>,
 ) -> Pass {
     let tiles = passes(scene).unwrap_or_else(|e| panic!("{e}"));
-    Tiler::new(scene, tiles, None, samples, progress)
-        .whole(Tiler::render, |tiles| film.merge_all(tiles))
+    let decided = film_decisions(scene, tiles, film);
+    let mut tiler = Tiler::new(scene, tiles, None, samples, progress);
+    tiler.decided = decided.as_deref();
+    let pass = tiler.whole(Tiler::render, |tiles| film.merge_all(tiles));
+    film.adaptive_counts = decided;
+    pass
 }
 
 /// Renders every sample of `scene` in groups of `group` tile rows and
@@ -416,20 +463,6 @@ pub fn render_rows(
     })
 }
 
-/// How a frame's camera samples reach pixels: as the scene says, but by
-/// filter importance sampling under adaptive sampling. Splatting mixes
-/// neighbours' samples into a pixel, weighted by their counts: a converged
-/// pixel's few samples would be outweighed in it by its neighbours' many
-/// (an emitter's edge pixels darkened by 10 % on the Cornell box); filter
-/// importance sampling keeps each pixel's estimate its own samples'.
-fn reconstruction_of(s: &crate::settings::RenderSettings) -> FilterSampling {
-    if s.adaptive.is_some() {
-        FilterSampling::Importance
-    } else {
-        s.filter_sampling
-    }
-}
-
 /// Renders the tiles of a frame's tile rows for one range of sample
 /// indices, reporting progress as batches finish.
 struct Tiler<'a> {
@@ -451,6 +484,10 @@ struct Tiler<'a> {
     /// Where asked for, each pixel's image samples (row-major, the whole
     /// frame): `--spp-map`.
     counts: Option<std::sync::Mutex<Vec<u32>>>,
+    /// Under adaptive sampling in passes, the image samples each pixel
+    /// takes in the whole render (row-major), decided by the first pass;
+    /// `None` where each tile decides its own (a whole render).
+    decided: Option<&'a [u32]>,
     progress: &'a Progress<'a>,
 }
 
@@ -470,12 +507,13 @@ impl<'a> Tiler<'a> {
             decision_sink: splats
                 .filter(|_| s.adaptive.is_some())
                 .map(|_| SplatFilm::sink(scene.filter.as_ref())),
-            reconstruction: Reconstruction::new(scene.filter.as_ref(), reconstruction_of(s)),
+            reconstruction: Reconstruction::new(scene.filter.as_ref(), s.filter_sampling),
             total: s.width as u64 * s.height as u64 * samples.len() as u64,
             samples,
             done: AtomicU64::new(0),
             traced: AtomicU64::new(0),
             counts: None,
+            decided: None,
             progress,
         }
     }
@@ -578,32 +616,26 @@ impl<'a> Tiler<'a> {
             width: w,
         };
         if let Some(a) = &self.scene.settings.adaptive {
-            let mut decisions = TileFilm::new(x0, y0, x1, y1, (w, h), self.reconstruction.reach());
-            let decision_ctx = TileContext {
-                splats: self.decision_sink.as_ref(),
-                ..self.context()
+            // Decisions first (their samples never reach the image), then
+            // this pass's share of each pixel's image samples, weighted by
+            // 1 / its count.
+            let counts = match self.decided {
+                Some(frame) => tile_counts(frame, rect),
+                None => self.decide(worker, a, rect),
             };
-            let counts = adaptive::run_tile(a, self.samples.end, rect, |batch, decision, add| {
-                let (ctx, out) = if decision {
-                    let out = TileOutput {
-                        film: &mut decisions,
-                        aovs: None,
-                        samples: Some(add),
-                    };
-                    (&decision_ctx, out)
-                } else {
-                    // The image's samples decide nothing: no per-sample
-                    // report (`run_tile` passes a no-op for them).
-                    let out = TileOutput {
-                        film: &mut tile,
-                        aovs: aovs.as_deref_mut(),
-                        samples: None,
-                    };
-                    (&ctx, out)
+            let spp = self.scene.settings.spp;
+            let share = |c| adaptive::pass_share(&self.samples, spp, c);
+            adaptive::render_image(&counts, rect, share, |batch, count| {
+                tile.set_scale(1.0 / count as f32);
+                let out = TileOutput {
+                    film: &mut tile,
+                    aovs: aovs.as_deref_mut(),
+                    samples: None,
                 };
-                worker.render(ctx, batch, out);
+                worker.render(&ctx, batch, out);
             });
-            let traced = counts.iter().map(|&c| u64::from(c)).sum();
+            tile.set_scale(1.0);
+            let traced = counts.iter().map(|&c| share(c).len() as u64).sum();
             self.finish_tile(rect, &counts, traced);
             return (tile, worker.rays() - rays_before);
         }
@@ -626,6 +658,38 @@ impl<'a> Tiler<'a> {
             self.record_counts(rect, &vec![self.samples.len() as u32; pixels as usize]);
         }
         (tile, worker.rays() - rays_before)
+    }
+
+    /// The rectangle of the tile whose top left pixel is (`x0`, `y0`).
+    fn rect(&self, (x0, y0): (u32, u32)) -> TileRect {
+        let (w, h) = (self.scene.settings.width, self.scene.settings.height);
+        TileRect {
+            x0,
+            y0,
+            x1: (x0 + TILE).min(w),
+            y1: (y0 + TILE).min(h),
+            width: w,
+        }
+    }
+
+    /// Makes adaptive sampling's decisions for tile `t` (decision samples
+    /// into a scratch film): the image samples each of its pixels takes.
+    fn decide(&self, worker: &mut dyn TileWorker, a: &adaptive::Adaptive, t: TileRect) -> Vec<u32> {
+        let s = &self.scene.settings;
+        let reach = self.reconstruction.reach();
+        let mut scratch = TileFilm::new(t.x0, t.y0, t.x1, t.y1, (s.width, s.height), reach);
+        let ctx = TileContext {
+            splats: self.decision_sink.as_ref(),
+            ..self.context()
+        };
+        adaptive::decide(a, s.spp, t, |batch, add| {
+            let out = TileOutput {
+                film: &mut scratch,
+                aovs: None,
+                samples: Some(add),
+            };
+            worker.render(&ctx, batch, out);
+        })
     }
 
     /// Ends an adaptive tile: counts its `traced` samples, records its
@@ -663,6 +727,17 @@ impl<'a> Tiler<'a> {
             splats: self.splats,
         }
     }
+}
+
+/// The counts of tile `t`'s pixels (row-major in the tile) in `frame`'s
+/// (row-major in the frame).
+fn tile_counts(frame: &[u32], t: TileRect) -> Vec<u32> {
+    (t.y0..t.y1)
+        .flat_map(|y| {
+            let start = (y * t.width + t.x0) as usize;
+            frame[start..start + (t.x1 - t.x0) as usize].iter().copied()
+        })
+        .collect()
 }
 
 #[cfg(test)]

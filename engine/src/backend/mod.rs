@@ -108,8 +108,8 @@ pub enum RenderError {
     /// The GPU failed or cannot render the scene.
     #[error(transparent)]
     Gpu(#[from] gpu::GpuError),
-    /// The render was asked in passes, and the integrator or adaptive
-    /// sampling cannot render that way.
+    /// The render was asked in passes, and the integrator cannot render
+    /// that way.
     #[error("{0}")]
     NoPasses(String),
 }

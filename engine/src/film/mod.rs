@@ -207,6 +207,11 @@ pub struct TileFilm {
     sums: Vec<Sums>,
     /// Samples whose value was NaN or infinite (recorded as zero).
     pub invalid_samples: u64,
+    /// The weight of the samples added next, value and filter weight both
+    /// (1 unless set): under adaptive sampling 1 / the samples their pixel
+    /// takes, so that every pixel weighs as much in a splat neighbourhood
+    /// however many samples it took.
+    scale: f32,
 }
 
 impl TileFilm {
@@ -219,7 +224,13 @@ impl TileFilm {
             current: vec![Vec4::ZERO; bounds.len()],
             sums: vec![Sums::ZERO; bounds.len()],
             invalid_samples: 0,
+            scale: 1.0,
         }
+    }
+
+    /// Weighs the samples added from now on by `scale` (see the field).
+    pub fn set_scale(&mut self, scale: f32) {
+        self.scale = scale;
     }
 
     /// Adds row `y` of this tile (its own row index) to `row`, the film's
@@ -256,7 +267,7 @@ impl TileFilm {
     pub fn splat(&mut self, pos: Vec2, value: Rgb, table: &FilterTable) {
         let value = self.checked(value);
         let (px0, px1, py0, py1) = self.bounds.footprint(pos, table.radius);
-        let v = value.extend(1.0);
+        let v = value.extend(1.0) * self.scale;
         let taps = (px1 - px0 + 1).max(0) as usize;
         // One row of weights, reused on every row of pixels.
         let mut wx = [0.0f32; MAX_TAPS];
@@ -305,6 +316,7 @@ impl TileFilm {
     pub fn add(&mut self, x: u32, y: u32, value: Rgb, weight: f32) {
         let value = self.checked(value);
         let i = self.bounds.index(x as i32, y as i32);
+        let weight = weight * self.scale;
         self.current[i] += (value * weight).extend(weight);
     }
 }
@@ -339,6 +351,13 @@ pub struct Film {
     sums: Vec<Sums>,
     /// Samples whose value was NaN or infinite (recorded as zero).
     pub invalid_samples: u64,
+    /// Under adaptive sampling, the image samples each pixel takes in the
+    /// whole render (row-major), decided by the first pass that renders
+    /// into this film: what a render's passes share beyond the sums (see
+    /// `integrators/adaptive.rs`). Not saved with the sums: the decisions
+    /// depend on the scene and its seed alone, so a resumed render makes
+    /// them again, the same.
+    pub adaptive_counts: Option<Vec<u32>>,
 }
 
 impl Film {
@@ -373,6 +392,7 @@ impl Film {
             band,
             sums,
             invalid_samples: 0,
+            adaptive_counts: None,
         })
     }
 

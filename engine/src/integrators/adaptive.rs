@@ -30,18 +30,37 @@
 //!   paths (a caustic) whose decision samples all missed them stops at
 //!   `min_spp`, unbiased but noisy: raise `min_spp` for such scenes.
 //!
-//! * **Reconstruction.** Pixels take different numbers of samples, so
-//!   the driver places samples by filter importance sampling
-//!   (`filter_sampling: importance`) whatever the film says: with
-//!   splatting, a pixel's value mixes its neighbours' samples weighted by
-//!   their counts, and a converged pixel's few samples are outweighed
-//!   (the edges of the Cornell box's light came out 10 % dark).
+//! * **Reconstruction, with splatting too.** The decisions never look at
+//!   the image's samples, so a tile makes them first ([`decide`]: rounds
+//!   of decision samples alone, each pixel's count of image samples
+//!   following from them) and renders the image samples afterwards
+//!   ([`render_image`]), each pixel's count known. A splatting filter
+//!   mixes neighbours' samples into a pixel; with unequal counts a
+//!   converged pixel's few samples would be outweighed by its neighbours'
+//!   many (the edges of the Cornell box's light came out 10 % dark). So a
+//!   pixel's samples are weighted by 1 / its count, value and filter
+//!   weight both: every pixel then adds its filter-weighted mean to its
+//!   neighbours, as at a fixed spp, and the film's ratio Σw·L / Σw has
+//!   the fixed-spp expectation. Filter importance sampling keeps each
+//!   pixel's samples in the pixel, where the weight cancels.
+//!
+//! * **In passes** (`--time`, `--checkpoint`, `--resume`, `--partition`):
+//!   a render's first pass makes every tile's decisions and keeps the
+//!   counts in the film ([`Film::adaptive_counts`](crate::film::Film));
+//!   each pass of sample indices a..b of a render of `spp` then renders
+//!   the same fraction of every pixel's samples ([`pass_share`]), so the
+//!   passes together render each pixel's `0..count`, the samples of one
+//!   whole render, and a film stopped after a pass holds about the same
+//!   fraction of every pixel's samples (to within a block of 4), so that
+//!   splatting weighs pixels alike in it too. The counts are not saved: a
+//!   resumed render, or each partition, decides again (the decision
+//!   samples depend on the scene and seed alone), the same counts at the
+//!   cost of the decision samples once more.
 //!
 //! Pixels are independent, so a tile runs its rounds alone: its pixels'
-//! counts and the decision statistics live in the tile ([`TileRounds`]),
-//! nothing crosses tiles or passes (so adaptive renders are whole renders,
-//! not passes). A round renders the runs of still-active pixels of each
-//! tile row as one batch each.
+//! counts and the decision statistics live in the tile. A round renders
+//! the runs of still-active pixels of each tile row as one batch each; the
+//! image samples are rendered by runs of pixels of equal count.
 
 use super::module::{Batch, batches};
 use radiant_core::{Rgb, luminance};
@@ -282,16 +301,18 @@ pub struct TileRect {
     pub width: u32,
 }
 
-/// Runs the rounds of adaptive sampling over one tile of a render of
-/// `spp` samples per pixel: `render(batch, decision, on_sample)` renders a
-/// batch — of image samples, or with `decision` of decision samples, which
-/// must not reach the image — and reports each sample's value by pixel.
-/// Returns the image samples each pixel took, row-major in the tile.
-pub fn run_tile(
+/// Decides how many image samples each pixel of tile `t` takes in a
+/// render of `spp` samples per pixel, by rounds of decision samples alone:
+/// `render(batch, on_sample)` renders a batch of decision samples (which
+/// must not reach the image) and reports each sample's value by pixel.
+/// The image samples never enter the decision, so they can be rendered
+/// afterwards, each pixel's count known ([`render_image`]). Returns the
+/// counts, row-major in the tile.
+pub fn decide(
     a: &Adaptive,
     spp: u32,
     t: TileRect,
-    mut render: impl FnMut(Batch, bool, &mut dyn FnMut(u32, Rgb)),
+    mut render: impl FnMut(Batch, &mut dyn FnMut(u32, Rgb)),
 ) -> Vec<u32> {
     let tw = t.x1 - t.x0;
     let len = (tw * (t.y1 - t.y0)) as usize;
@@ -308,15 +329,10 @@ pub fn run_tile(
         } else {
             (n + a.batch).min(most)
         };
-        for_runs(&active, t, n..target, &mut |b| {
-            render(b, false, &mut |_, _| ())
-        });
         let per_round = decision_samples(target - n);
         let samples = DECISION_BASE + decided..DECISION_BASE + decided + per_round;
         for_runs(&active, t, samples, &mut |b| {
-            render(b, true, &mut |p, v| {
-                decision[index(p)].add(sample_luminance(v))
-            })
+            render(b, &mut |p, v| decision[index(p)].add(sample_luminance(v)))
         });
         decided += per_round;
         for (c, _) in counts.iter_mut().zip(&active).filter(|(_, a)| **a) {
@@ -336,6 +352,53 @@ pub fn run_tile(
         }
     }
     counts
+}
+
+/// Renders the image samples of tile `t` whose pixels take `counts`
+/// samples (from [`decide`]): of a pixel taking `c`, the sample indices
+/// `samples(c)`. `render(batch, c)` renders a batch whose pixels all take
+/// `c` (a splatting film weights their samples by 1/`c`, see
+/// `backend/cpu.rs`).
+pub fn render_image(
+    counts: &[u32],
+    t: TileRect,
+    samples: impl Fn(u32) -> std::ops::Range<u32>,
+    mut render: impl FnMut(Batch, u32),
+) {
+    let mut classes = counts.to_vec();
+    classes.sort_unstable();
+    classes.dedup();
+    let mut members = vec![false; counts.len()];
+    for c in classes {
+        let range = samples(c);
+        if range.is_empty() {
+            continue;
+        }
+        for (m, &n) in members.iter_mut().zip(counts) {
+            *m = n == c;
+        }
+        for_runs(&members, t, range, &mut |b| render(b, c));
+    }
+}
+
+/// The part of a pixel's `count` image samples that the pass of sample
+/// indices `pass` (of a render of `spp` per pixel) renders: the same
+/// fraction of every pixel's samples, so that after each pass every pixel
+/// holds about that fraction of its samples, its ends rounded down to
+/// whole blocks of [`BLOCK`](crate::film::exact::BLOCK) samples (so the
+/// film's exact sums do not depend on where passes start); the pass that
+/// ends at `spp` ends at `count`. A whole render's one pass `0..spp`
+/// renders `0..count`.
+pub fn pass_share(pass: &std::ops::Range<u32>, spp: u32, count: u32) -> std::ops::Range<u32> {
+    let block = crate::film::exact::BLOCK;
+    let end = |x: u32| {
+        if x >= spp {
+            count
+        } else {
+            (u64::from(x) * u64::from(count) / u64::from(spp.max(1))) as u32 / block * block
+        }
+    };
+    end(pass.start)..end(pass.end)
 }
 
 /// Cuts the sample indices `samples` of the active pixels of tile `t`
