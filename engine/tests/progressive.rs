@@ -390,3 +390,106 @@ fn wrong_resume_inputs_name_the_file() {
         &[&name(&part), "it is sample partition 1/2 of a frame"],
     );
 }
+
+/// The options of a banded render of the shot, 64×512 pixels: with
+/// `--whole-film-pixels 0` every frame renders in bands, as frames over
+/// 16 Mpixels do (on 2 threads, groups of 8 tile rows: 128 rows).
+const BANDED: [&str; 6] = [
+    "--width",
+    "64",
+    "--height",
+    "512",
+    "--whole-film-pixels",
+    "0",
+];
+
+/// Samples per pixel for about `seconds` seconds of a banded render of
+/// `scene` (a one-second `--time` render of the same size into `dir`).
+fn banded_samples(scene: &Path, dir: &Path, seconds: u32) -> String {
+    let probe = dir.join("probe.exr");
+    rendered(
+        scene,
+        &probe,
+        &[&BANDED[..4], &["--time", "1s", "--spp", "1000000"]].concat(),
+    );
+    let spp = samples_in(&probe) * seconds;
+    std::fs::remove_file(&probe).unwrap();
+    spp.max(16).to_string()
+}
+
+/// Ctrl-C in a banded render: the file is written (atomically: nothing
+/// else is left in the folder) with the rows of the bands finished so
+/// far, those of the uninterrupted render bit for bit, and black below;
+/// the render says how many rows and samples it holds and exits with 130.
+#[test]
+fn an_interrupted_banded_render_keeps_its_finished_rows() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = shot(dir.path(), "shot.yaml", "independent");
+    let spp = banded_samples(&scene, dir.path(), 6);
+    let options = [&BANDED[..], &["--spp", &spp]].concat();
+
+    let out = dir.path().join("frame.exr");
+    let child = spawn_render(&scene, &out, &options);
+    wait_for_sigint_handler(child.id());
+    std::thread::sleep(Duration::from_secs(2));
+    let o = interrupt(child);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(130), "{e}");
+    let rows = number_after(&e, "interrupted: the top ") as usize;
+    assert!(rows > 0 && rows < 512 && rows.is_multiple_of(128), "{rows}: {e}");
+    let samples = rows * 64 * spp.parse::<usize>().unwrap();
+    assert!(
+        e.contains(&format!(
+            "interrupted: the top {rows} of 512 rows finished, {samples} samples ({spp} spp a \
+             pixel), written to {}; the rows below are black",
+            out.display()
+        )),
+        "{e}"
+    );
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2, "{e}");
+
+    let whole = dir.path().join("whole.exr");
+    rendered(&scene, &whole, &options);
+    let (cut, whole) = (read(&out), read(&whole));
+    let at = rows * 64;
+    // The last rows lack only the next band's splats; those above it are
+    // the uninterrupted render's.
+    let above = (rows - 4) * 64;
+    assert!(cut.pixels[..above] == whole.pixels[..above]);
+    let sum = |image: &radiant::film::Image| -> f32 {
+        image.pixels[above..at]
+            .iter()
+            .map(|p| p.element_sum())
+            .sum()
+    };
+    let (edge, whole_edge) = (sum(&cut), sum(&whole));
+    assert!(
+        (edge - whole_edge).abs() <= 0.25 * whole_edge,
+        "{edge} {whole_edge}"
+    );
+    assert!(cut.pixels[at..].iter().all(|p| *p == glam::Vec3::ZERO));
+}
+
+/// Ctrl-C in a sequence of banded frames: the finished frames stay, the
+/// frame in progress writes nothing (no file, no temporary file), and the
+/// exit status is 130.
+#[test]
+fn an_interrupted_banded_sequence_keeps_only_its_finished_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = shot(dir.path(), "shot.yaml", "independent");
+    let spp = banded_samples(&scene, dir.path(), 2);
+    let options = [&BANDED[..], &["--spp", &spp, "--frames", "1..3"]].concat();
+
+    let out = dir.path().join("seq_####.exr");
+    let child = spawn_render(&scene, &out, &options);
+    let frame = |n: u32| dir.path().join(format!("seq_{n:04}.exr"));
+    wait_for(&frame(1));
+    std::thread::sleep(Duration::from_millis(500));
+    let o = interrupt(child);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(130), "{e}");
+    assert!(frame(1).exists(), "{e}");
+    assert!(!frame(2).exists() && !frame(3).exists(), "{e}");
+    assert!(e.contains("interrupted: this frame is not written"), "{e}");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2, "{e}");
+}

@@ -30,7 +30,7 @@ pub mod twin;
 pub use reference::Reference;
 pub use sweep::{Axis, Curve, Setting};
 
-use crate::backend::gpu::{GpuBackend, GpuOptions};
+use crate::backend::Backend;
 use crate::extract::Overrides;
 use crate::scene::{Scene, SceneError};
 use radiant_core::Registry;
@@ -64,7 +64,7 @@ pub enum AccuracyError {
     WholeFilm(Box<crate::film::memory::FrameTooLarge>),
     /// The GPU failed, or cannot render the scene.
     #[error(transparent)]
-    Gpu(#[from] crate::backend::gpu::GpuError),
+    Gpu(#[from] crate::backend::RenderError),
     /// The `backend` axis was asked for without a GPU to measure.
     #[error("the backend axis needs a hardware GPU: {0}")]
     NoGpu(String),
@@ -222,20 +222,31 @@ pub fn run(
 }
 
 /// The hardware GPU the `backend` axis measures on, opened once per
-/// process; why there is none otherwise (none found, or only a software
-/// one, whose speed says nothing).
-pub(crate) fn shared_gpu() -> Result<&'static Mutex<GpuBackend>, String> {
-    static GPU: OnceLock<Result<Mutex<GpuBackend>, String>> = OnceLock::new();
-    GPU.get_or_init(|| match GpuBackend::new(&GpuOptions::default()) {
-        Ok(g) if !g.is_software() => Ok(Mutex::new(g)),
+/// process; why there is none otherwise (none found, only a software one,
+/// whose speed says nothing, or a build without the `gpu` feature).
+pub(crate) fn shared_gpu() -> Result<&'static Mutex<Box<dyn Backend>>, String> {
+    static GPU: OnceLock<Result<Mutex<Box<dyn Backend>>, String>> = OnceLock::new();
+    GPU.get_or_init(open_gpu).as_ref().map_err(Clone::clone)
+}
+
+/// Opens the GPU of [`shared_gpu`].
+#[cfg(feature = "gpu")]
+fn open_gpu() -> Result<Mutex<Box<dyn Backend>>, String> {
+    use crate::backend::gpu::GpuBackend;
+    match GpuBackend::new(&Default::default()) {
+        Ok(g) if !g.is_software() => Ok(Mutex::new(Box::new(g))),
         Ok(g) => Err(format!(
             "the only adapter, {}, is a software one",
             g.adapter()
         )),
         Err(e) => Err(e.to_string()),
-    })
-    .as_ref()
-    .map_err(Clone::clone)
+    }
+}
+
+/// [`shared_gpu`] without the GPU backend.
+#[cfg(not(feature = "gpu"))]
+fn open_gpu() -> Result<Mutex<Box<dyn Backend>>, String> {
+    Err(crate::backend::RenderError::GpuNotBuilt.to_string())
 }
 
 /// The files [`write()`] makes in its folder.

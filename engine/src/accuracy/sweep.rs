@@ -390,7 +390,8 @@ pub fn measure(
     reference.check_size(render.settings.width, render.settings.height)?;
     let gpu = match setting.change {
         Change::Gpu => {
-            crate::backend::gpu::Plan::check(&render)?;
+            #[cfg(feature = "gpu")]
+            crate::backend::gpu::Plan::check(&render).map_err(crate::backend::RenderError::from)?;
             Some(super::shared_gpu().map_err(AccuracyError::NoGpu)?)
         }
         _ => None,

@@ -11,7 +11,7 @@
 
 use super::metrics::Halves;
 use crate::backend::cpu::{self, Progress, render_samples, render_samples_with_aovs};
-use crate::backend::gpu::GpuBackend;
+use crate::backend::Backend;
 use crate::error::{SceneError, module_error};
 use crate::extract::RenderScene;
 use crate::film::aov::AovFilm;
@@ -35,7 +35,7 @@ pub struct TwinRender {
     spp: u32,
     time: Duration,
     /// The GPU that renders instead of the CPU (the `backend` axis).
-    gpu: Option<&'static Mutex<GpuBackend>>,
+    gpu: Option<&'static Mutex<Box<dyn Backend>>>,
     /// The first failure (the GPU's, or a whole render's memory);
     /// rendering stops there.
     error: Option<super::AccuracyError>,
@@ -131,7 +131,7 @@ impl TwinRender {
     }
 
     /// The same renders on `gpu` where it is given.
-    pub fn on_gpu(self, gpu: Option<&'static Mutex<GpuBackend>>) -> Self {
+    pub fn on_gpu(self, gpu: Option<&'static Mutex<Box<dyn Backend>>>) -> Self {
         Self { gpu, ..self }
     }
 

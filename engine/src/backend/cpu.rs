@@ -13,12 +13,12 @@
 //! encoder while the next group renders, so a frame written with
 //! [`write`] needs memory in proportion to its width, not its area.
 
-use super::RenderError;
+use super::{Interrupt, RenderError};
 pub use super::{Progress, Rendered, Written};
 use crate::extract::RenderScene;
 use crate::film::aov::{AovFilm, AovImage, AovTile};
 use crate::film::band::Bands;
-use crate::film::encode::{RowSink, write_encoded};
+use crate::film::encode::{BLOCK_ROWS, RowSink, write_encoded};
 use crate::film::memory::FrameTooLarge;
 use crate::film::{Film, Image, Reconstruction, TileFilm};
 use crate::integrators::adaptive::{self, TileRect};
@@ -30,7 +30,7 @@ use radiant_core::Rgb;
 use rayon::prelude::*;
 use std::ops::Range;
 use std::path::Path;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 /// Tile edge in pixels.
@@ -331,6 +331,22 @@ pub fn write(
     path: &Path,
     progress: &Progress<'_>,
 ) -> Result<Written, RenderError> {
+    write_until(scene, path, progress, Interrupt::NEVER)
+}
+
+/// [`write`], stopping early where `interrupt` is raised (Ctrl-C): the
+/// tiles in flight finish, the group they belong to is dropped, and the
+/// file gets the rows of the groups merged so far and black below them, as
+/// [`render_rows`] says (nothing where `interrupt.keep` is false, or no
+/// group was merged: [`RenderError::Interrupted`]). A scene that does not
+/// render in bands (splats) renders whole and does not stop ([`passes`]
+/// says which).
+pub fn write_until(
+    scene: &RenderScene,
+    path: &Path,
+    progress: &Progress<'_>,
+    interrupt: Interrupt<'_>,
+) -> Result<Written, RenderError> {
     let s = &scene.settings;
     if passes(scene).is_err() {
         // Splats and adaptive decisions reach the whole image: render it
@@ -342,7 +358,7 @@ pub fn write(
     }
     let group = band_tile_rows(scene);
     write_encoded(path, &s.output, s.width, s.height, |rows| {
-        render_rows(scene, rows, group, progress)
+        render_rows(scene, rows, group, progress, interrupt)
     })
 }
 
@@ -417,16 +433,27 @@ pub fn render_samples(
 /// tiles are rendered and merged exactly as there. Each group's finished
 /// rows are encoded while the next group renders. Fails before any sample
 /// is traced where the band does not fit in memory.
+///
+/// Where `interrupt` is raised, tiles not yet started are skipped and
+/// their group dropped; the rows of the groups merged before it are
+/// handed on, each with all its own samples (the last few lack only the
+/// next group's splats, and are normalised by the weights they have),
+/// and the rest of the image is black. [`Written::samples`] counts the
+/// samples of the merged rows. Where no group was merged, or
+/// `interrupt.keep` is false, it fails with [`RenderError::Interrupted`]
+/// instead.
 pub fn render_rows(
     scene: &RenderScene,
     rows: &mut dyn RowSink,
     group: u32,
     progress: &Progress<'_>,
+    interrupt: Interrupt<'_>,
 ) -> Result<Written, RenderError> {
     let start = Instant::now();
     let s = &scene.settings;
     let tiles = passes(scene)?;
-    let tiler = Tiler::new(scene, tiles, None, 0..s.spp, progress);
+    let mut tiler = Tiler::new(scene, tiles, None, 0..s.spp, progress);
+    tiler.stop = Some(interrupt.flag);
     let bands = tiler.bands(group);
     let threads = rayon::current_num_threads();
     // A thread's first allocation makes glibc reserve it an arena of
@@ -441,7 +468,7 @@ pub fn render_rows(
     finished
         .try_reserve_exact(bands.rows() as usize * s.width as usize)
         .map_err(|_| too_large())?;
-    let mut rays = 0;
+    let (mut rays, mut merged) = (0, 0);
     for group in bands.groups() {
         let ((tiles, r), written) = rayon::join(
             || tiler.render(group.clone()),
@@ -449,15 +476,34 @@ pub fn render_rows(
         );
         written?;
         finished.clear();
+        if tiler.cut.load(Ordering::Relaxed) {
+            break;
+        }
         film.merge_all(&tiles);
         rays += r;
+        merged = (group.end * TILE).min(s.height);
         film.advance(bands.finished(&group), &mut finished)
             .map_err(|_| too_large())?;
     }
-    rows.write_rows(&finished)?;
+    if merged < s.height {
+        if merged == 0 || !interrupt.keep {
+            return Err(RenderError::Interrupted);
+        }
+        film.advance(merged, &mut finished)
+            .map_err(|_| too_large())?;
+        rows.write_rows(&finished)?;
+        finished.clear();
+        finished.resize(s.width as usize * BLOCK_ROWS as usize, Rgb::ZERO);
+        for y in (merged..s.height).step_by(BLOCK_ROWS as usize) {
+            let black = (s.height - y).min(BLOCK_ROWS) as usize * s.width as usize;
+            rows.write_rows(&finished[..black])?;
+        }
+    } else {
+        rows.write_rows(&finished)?;
+    }
     Ok(Written {
         time: start.elapsed(),
-        samples: tiler.total,
+        samples: tiler.total / u64::from(s.height) * u64::from(merged),
         rays,
         invalid_samples: film.invalid_samples,
     })
@@ -489,6 +535,11 @@ struct Tiler<'a> {
     /// `None` where each tile decides its own (a whole render).
     decided: Option<&'a [u32]>,
     progress: &'a Progress<'a>,
+    /// Raised to stop (a banded write's Ctrl-C): tiles not yet started
+    /// are skipped, and `cut` says that one was.
+    stop: Option<&'a AtomicBool>,
+    /// Whether a tile was skipped.
+    cut: AtomicBool,
 }
 
 impl<'a> Tiler<'a> {
@@ -515,6 +566,8 @@ impl<'a> Tiler<'a> {
             counts: None,
             decided: None,
             progress,
+            stop: None,
+            cut: AtomicBool::new(false),
         }
     }
 
@@ -606,6 +659,10 @@ impl<'a> Tiler<'a> {
         let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
         let pixels = (x1 - x0) * (y1 - y0);
         let mut tile = TileFilm::new(x0, y0, x1, y1, (w, h), self.reconstruction.reach());
+        if self.stop.is_some_and(|stop| stop.load(Ordering::Relaxed)) {
+            self.cut.store(true, Ordering::Relaxed);
+            return (tile, 0);
+        }
         let rays_before = worker.rays();
         let ctx = self.context();
         let rect = TileRect {
@@ -806,7 +863,8 @@ pub(crate) mod tests {
         for group in [1, 2, 3, 4] {
             let mut rows = Collect::default();
             let written = on_threads(2, || {
-                render_rows(&r, &mut rows, group, &Progress::none()).expect("fits")
+                render_rows(&r, &mut rows, group, &Progress::none(), Interrupt::NEVER)
+                    .expect("fits")
             });
             assert!(
                 rows.pixels == whole.image.pixels,
@@ -831,7 +889,7 @@ pub(crate) mod tests {
             crate::film::output::write(&reference, &whole).expect("written");
             on_threads(2, || {
                 write_with(&streamed, 37, 45, |rows| {
-                    render_rows(&r, rows, 1, &Progress::none())
+                    render_rows(&r, rows, 1, &Progress::none(), Interrupt::NEVER)
                 })
             })
             .expect("written");

@@ -1,13 +1,19 @@
 //! Backends render an extracted frame. [`cpu`] runs the wavefront path
-//! tracer on every core through rayon; [`gpu`] runs it as a wgpu compute
-//! kernel assembled from the frame's modules. [`Backend`] is the seam the
-//! command line renders through, and [`choose`] picks one as
-//! `--backend cpu|gpu|auto` asks; [`progressive`] renders through it in
-//! passes (`--time`, `--checkpoint`, `--resume`).
+//! tracer on every core through rayon; `gpu` (with the default-on `gpu`
+//! cargo feature) runs it as a wgpu compute kernel assembled from the
+//! frame's modules. [`Backend`] is the seam the command line renders
+//! through, and [`choose`] picks one as `--backend cpu|gpu|auto` asks
+//! ([`gpu_options`] holds what `--gpu-…` flags ask of the GPU, with or
+//! without the feature); [`progressive`] renders through it in passes
+//! (`--time`, `--checkpoint`, `--resume`).
 
 pub mod cpu;
+#[cfg(feature = "gpu")]
 pub mod gpu;
+pub mod gpu_options;
 pub mod progressive;
+
+pub use gpu_options::{BvhLayout, GpuKernel, GpuOptions};
 
 use crate::extract::RenderScene;
 use crate::film::memory::FrameTooLarge;
@@ -15,6 +21,7 @@ use crate::film::output::ImageError;
 use crate::film::{Film, Image};
 use std::ops::Range;
 use std::path::Path;
+use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 use thiserror::Error;
 
@@ -46,6 +53,27 @@ impl<'a> Progress<'a> {
         }
     }
 }
+
+/// Asks a render to stop early (Ctrl-C), and what to keep of it then.
+#[derive(Debug, Clone, Copy)]
+pub struct Interrupt<'a> {
+    /// Raised to stop.
+    pub flag: &'a AtomicBool,
+    /// Whether an interrupted frame's file is written with what it holds
+    /// (else none is: a frame of a sequence appears only when finished).
+    pub keep: bool,
+}
+
+impl Interrupt<'static> {
+    /// Never raised.
+    pub const NEVER: Self = Self {
+        flag: &NEVER_RAISED,
+        keep: false,
+    };
+}
+
+/// The flag of [`Interrupt::NEVER`].
+static NEVER_RAISED: AtomicBool = AtomicBool::new(false);
 
 /// A finished render.
 pub struct Rendered {
@@ -106,12 +134,25 @@ pub enum RenderError {
     #[error(transparent)]
     Output(#[from] ImageError),
     /// The GPU failed or cannot render the scene.
+    #[cfg(feature = "gpu")]
     #[error(transparent)]
     Gpu(#[from] gpu::GpuError),
+    /// The GPU was asked for, and this build has no GPU backend.
+    #[error(
+        "this build of radiant has no GPU backend: it was built without the `gpu` cargo \
+         feature (on by default). Build it with the feature (`cargo build --release --features \
+         gpu`; a crate that depends on radiant with `default-features = false` adds \
+         `features = [\"gpu\"]`), or render with `--backend cpu` (or `auto`)"
+    )]
+    GpuNotBuilt,
     /// The render was asked in passes, and the integrator cannot render
     /// that way.
     #[error("{0}")]
     NoPasses(String),
+    /// The render was interrupted with nothing to keep: before its first
+    /// band of rows was finished, or as a frame of a sequence.
+    #[error("interrupted before the frame was finished: nothing written")]
+    Interrupted,
 }
 
 /// Something that renders frames: the CPU path tracer or the GPU one.
@@ -158,6 +199,27 @@ pub trait Backend: Send {
         Ok(Written::from(&rendered))
     }
 
+    /// [`Backend::write`], stopping early where `interrupt` is raised, if
+    /// the backend can for `scene` ([`Backend::stops_early`]); this
+    /// default renders everything.
+    fn write_until(
+        &mut self,
+        scene: &RenderScene,
+        path: &Path,
+        progress: &Progress<'_>,
+        interrupt: Interrupt<'_>,
+    ) -> Result<Written, RenderError> {
+        let _ = interrupt;
+        self.write(scene, path, progress)
+    }
+
+    /// Whether [`Backend::write_until`] stops early for `scene` (else
+    /// Ctrl-C is better left to quit at once). This default says no.
+    fn stops_early(&self, scene: &RenderScene) -> bool {
+        let _ = scene;
+        false
+    }
+
     /// What the last render counted beyond [`Rendered`], as a line for
     /// the user (the GPU's rays by kind and traversal work), if anything.
     fn counts(&self) -> Option<String> {
@@ -201,8 +263,23 @@ impl Backend for CpuBackend {
     ) -> Result<Written, RenderError> {
         cpu::write(scene, path, progress)
     }
+
+    fn write_until(
+        &mut self,
+        scene: &RenderScene,
+        path: &Path,
+        progress: &Progress<'_>,
+        interrupt: Interrupt<'_>,
+    ) -> Result<Written, RenderError> {
+        cpu::write_until(scene, path, progress, interrupt)
+    }
+
+    fn stops_early(&self, scene: &RenderScene) -> bool {
+        cpu::passes(scene).is_ok()
+    }
 }
 
+#[cfg(feature = "gpu")]
 impl Backend for gpu::GpuBackend {
     fn describe(&self) -> String {
         format!("gpu: {}, {}", self.adapter(), self.kernel())
@@ -270,41 +347,104 @@ pub enum BackendKind {
 }
 
 /// The backend `kind` asks for (a GPU opened with `options`), for frames
-/// like `scene`; `note` receives what `auto` chose and why.
+/// like `scene`; `note` receives what `auto` chose and why. Without the
+/// `gpu` feature, `gpu` is [`RenderError::GpuNotBuilt`] and `auto` the CPU.
 pub fn choose(
     kind: BackendKind,
-    options: &gpu::GpuOptions,
+    options: &GpuOptions,
     scene: &RenderScene,
     note: &mut dyn FnMut(String),
-) -> Result<Box<dyn Backend>, gpu::GpuError> {
+) -> Result<Box<dyn Backend>, RenderError> {
     match kind {
         BackendKind::Cpu => Ok(Box::new(CpuBackend)),
+        #[cfg(feature = "gpu")]
         BackendKind::Gpu => {
             gpu::Plan::check(scene)?;
             Ok(Box::new(gpu::GpuBackend::new(options)?))
         }
-        BackendKind::Auto => {
-            if let Err(e) = gpu::Plan::check(scene) {
-                note(format!("backend: cpu ({e})"));
-                return Ok(Box::new(CpuBackend));
-            }
-            match gpu::GpuBackend::new(options) {
-                Ok(g) if !g.is_software() => {
-                    note(format!("backend: gpu, adapter {}", g.adapter()));
-                    Ok(Box::new(g))
-                }
-                Ok(g) => {
-                    note(format!(
-                        "backend: cpu (the only GPU adapter, {}, is a software one; `--backend gpu` uses it anyway)",
-                        g.adapter()
-                    ));
-                    Ok(Box::new(CpuBackend))
-                }
-                Err(e) => {
-                    note(format!("backend: cpu ({e})"));
-                    Ok(Box::new(CpuBackend))
-                }
-            }
+        #[cfg(not(feature = "gpu"))]
+        BackendKind::Gpu => {
+            let _ = (options, scene);
+            Err(RenderError::GpuNotBuilt)
         }
+        #[cfg(feature = "gpu")]
+        BackendKind::Auto => Ok(auto(options, scene, note)),
+        #[cfg(not(feature = "gpu"))]
+        BackendKind::Auto => {
+            note(
+                "backend: cpu (this build has no GPU backend: the `gpu` cargo feature is off)"
+                    .into(),
+            );
+            Ok(Box::new(CpuBackend))
+        }
+    }
+}
+
+/// `--backend auto`: the GPU where a hardware adapter is found and the
+/// scene has GPU code for all its modules, else the CPU, saying which
+/// through `note`.
+#[cfg(feature = "gpu")]
+fn auto(
+    options: &GpuOptions,
+    scene: &RenderScene,
+    note: &mut dyn FnMut(String),
+) -> Box<dyn Backend> {
+    if let Err(e) = gpu::Plan::check(scene) {
+        note(format!("backend: cpu ({e})"));
+        return Box::new(CpuBackend);
+    }
+    match gpu::GpuBackend::new(options) {
+        Ok(g) if !g.is_software() => {
+            note(format!("backend: gpu, adapter {}", g.adapter()));
+            Box::new(g)
+        }
+        Ok(g) => {
+            note(format!(
+                "backend: cpu (the only GPU adapter, {}, is a software one; `--backend gpu` uses it anyway)",
+                g.adapter()
+            ));
+            Box::new(CpuBackend)
+        }
+        Err(e) => {
+            note(format!("backend: cpu ({e})"));
+            Box::new(CpuBackend)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_missing_gpu_feature_says_how_to_enable_it() {
+        let message = RenderError::GpuNotBuilt.to_string();
+        for needed in [
+            "`gpu` cargo feature",
+            "--features gpu",
+            "features = [\"gpu\"]",
+            "--backend cpu",
+        ] {
+            assert!(message.contains(needed), "{needed} in {message}");
+        }
+        assert!(!message.contains("  "), "a run of spaces in {message}");
+    }
+
+    /// Without the feature, `gpu` is refused with that message and `auto`
+    /// renders on the CPU, saying why.
+    #[cfg(not(feature = "gpu"))]
+    #[test]
+    fn without_the_gpu_feature_gpu_is_refused_and_auto_is_the_cpu() {
+        let scene = cpu::tests::cornell_scene(8, 8, 1);
+        let options = GpuOptions::default();
+        let refused = choose(BackendKind::Gpu, &options, &scene, &mut |_| {});
+        assert!(matches!(refused, Err(RenderError::GpuNotBuilt)));
+        let mut notes = Vec::new();
+        let auto = choose(BackendKind::Auto, &options, &scene, &mut |n| notes.push(n));
+        assert!(auto.is_ok_and(|b| b.describe().starts_with("cpu")));
+        assert!(
+            notes.iter().any(|n| n.contains("`gpu` cargo feature")),
+            "{notes:?}"
+        );
     }
 }

@@ -3,7 +3,7 @@
 use super::diagnostic::report;
 use clap::Args;
 use radiant::Registry;
-use radiant::backend::gpu::{BvhLayout, GpuKernel, Plan};
+use radiant::backend::{BvhLayout, GpuKernel};
 use radiant::extract::{Overrides, RenderScene, extract};
 use std::path::{Path, PathBuf};
 
@@ -41,13 +41,14 @@ pub enum InfoBackend {
 
 /// Prints what the GPU kernel of `r` compiles in; writes it to
 /// `dump/kernel.wgsl` if asked.
+#[cfg(feature = "gpu")]
 fn gpu_kernel(
     r: &RenderScene,
     bvh: BvhLayout,
     kernel: GpuKernel,
     dump: Option<&Path>,
 ) -> miette::Result<()> {
-    let plan = Plan::with_bvh(r, bvh)
+    let plan = radiant::backend::gpu::Plan::with_bvh(r, bvh)
         .map_err(|e| miette::miette!("{e}"))?
         .for_kernel(kernel, false);
     for (kind, types) in plan.modules.summary() {
@@ -82,6 +83,15 @@ fn gpu_kernel(
         println!("gpu source   {}", file.display());
     }
     Ok(())
+}
+
+/// [`gpu_kernel`] in a build without the GPU backend: says how to get it.
+#[cfg(not(feature = "gpu"))]
+fn gpu_kernel(_: &RenderScene, _: BvhLayout, _: GpuKernel, _: Option<&Path>) -> miette::Result<()> {
+    Err(miette::miette!(
+        "{}",
+        radiant::backend::RenderError::GpuNotBuilt
+    ))
 }
 
 /// What besides shapes animates: the camera, lights, materials and

@@ -1,6 +1,7 @@
 //! `radiant render`: render a scene, or a range of its frames, to image
 //! files.
 
+mod banded;
 mod partition;
 mod passes;
 mod progressive;
@@ -67,13 +68,13 @@ pub struct RenderArgs {
     /// path) or `wavefront` (generate, extend, shade, connect and
     /// accumulate stages with queues between them; with `--gpu-stats` both
     /// print their GPU time per stage).
-    #[arg(long, value_enum, default_value_t = radiant::backend::gpu::GpuKernel::Megakernel)]
-    gpu_kernel: radiant::backend::gpu::GpuKernel,
+    #[arg(long, value_enum, default_value_t = radiant::backend::GpuKernel::Megakernel)]
+    gpu_kernel: radiant::backend::GpuKernel,
     /// On the GPU, the hierarchy layout: `binary` (two child boxes per
     /// 64-byte node) or `wide` (compressed wide BVH: eight quantized child
     /// boxes per 80-byte node).
-    #[arg(long, value_enum, default_value_t = radiant::backend::gpu::BvhLayout::Binary)]
-    gpu_bvh: radiant::backend::gpu::BvhLayout,
+    #[arg(long, value_enum, default_value_t = radiant::backend::BvhLayout::Binary)]
+    gpu_bvh: radiant::backend::BvhLayout,
     /// Render only the K-th of N disjoint sample partitions of one frame
     /// (`3/16`) into a partial EXR file for `radiant merge`.
     #[arg(long, value_parser = clap::value_parser!(radiant::farm::partition::Partition))]
@@ -281,7 +282,7 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
                     } else {
                         args.backend
                     },
-                    &radiant::backend::gpu::GpuOptions {
+                    &radiant::backend::GpuOptions {
                         stats: args.gpu_stats,
                         kernel: args.gpu_kernel,
                         bvh: args.gpu_bvh,
@@ -331,6 +332,9 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
                 let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
                 let interrupt = progressive.as_ref().map(|p| p.interrupt()).transpose()?;
                 passes::write(&args.passes, s, &path, &progress, &note, interrupt)
+            } else if let Some(p) = progressive.as_ref().filter(|_| backend.stops_early(s)) {
+                let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
+                banded::write(backend.as_mut(), s, &path, &progress, &note, p.interrupt()?)
             } else {
                 backend
                     .write(s, &path, &progress)

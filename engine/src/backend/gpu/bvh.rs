@@ -15,12 +15,12 @@
 //! Leaves reference runs of item slots; [`Level::order`] says which item
 //! each slot holds.
 
+use super::BvhLayout;
 use super::upload::Vec4;
 use glam::Vec3A;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
-use std::fmt;
 use std::time::Duration;
 
 /// A binary node: four rows (see the module docs).
@@ -29,19 +29,6 @@ type Node = [Vec4; 4];
 /// Primitives per leaf at most.
 const MAX_LEAF: u32 = 4;
 
-/// The hierarchy layout of the GPU backend (`--gpu-bvh`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-pub enum BvhLayout {
-    /// Binary BVH, two child boxes per 64-byte node, up to 4 primitives
-    /// per leaf.
-    #[default]
-    Binary,
-    /// Compressed wide BVH (Ylitie et al. 2017): eight quantized child
-    /// boxes per 80-byte node, up to 3 primitives per leaf.
-    Wide,
-}
-
 impl BvhLayout {
     /// `vec4f` rows per node.
     pub fn rows_per_node(self) -> usize {
@@ -49,15 +36,6 @@ impl BvhLayout {
             BvhLayout::Binary => 4,
             BvhLayout::Wide => super::cwbvh::ROWS,
         }
-    }
-}
-
-impl fmt::Display for BvhLayout {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            BvhLayout::Binary => "binary (64-byte nodes, 2 children)",
-            BvhLayout::Wide => "compressed wide (80-byte nodes, 8 children)",
-        })
     }
 }
 

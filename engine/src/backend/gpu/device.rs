@@ -3,28 +3,10 @@
 //! kernel with naga so that a compile error names the module its line is
 //! in, and reading buffers back.
 
+use super::GpuOptions;
 use super::error::GpuError;
 use super::kernel::Kernel;
 use std::sync::{Arc, Mutex};
-
-/// How to open the GPU.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct GpuOptions {
-    /// The largest storage buffer the frame will need, if known: an
-    /// adapter that cannot bind one that large is refused up front.
-    pub storage_buffer_bytes: Option<u64>,
-    /// Compile traversal counters into the kernel (nodes visited,
-    /// primitives tested; slower), read with
-    /// [`GpuBackend::last_stats`](super::GpuBackend::last_stats).
-    pub stats: bool,
-    /// The hierarchy layout of the frames' geometry (`--gpu-bvh`).
-    pub bvh: super::BvhLayout,
-    /// Which kernel renders the paths (`--gpu-kernel`).
-    pub kernel: super::GpuKernel,
-    /// Path slots of the wavefront's pool, if not its default (at most
-    /// 2^19, fewer where a batch has fewer work items).
-    pub wavefront_paths: Option<u32>,
-}
 
 /// Errors the device reported outside a call (validation, out of memory,
 /// device loss), kept until [`ErrorSink::check`] turns them into a

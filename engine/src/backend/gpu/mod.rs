@@ -27,11 +27,9 @@ pub mod trace;
 pub mod upload;
 pub mod wavefront;
 
-pub use bvh::BvhLayout;
-pub use device::GpuOptions;
+pub use super::gpu_options::{BvhLayout, GpuKernel, GpuOptions};
 pub use error::GpuError;
 pub use timing::{Stage, StageTimes};
-pub use wavefront::GpuKernel;
 
 use super::cpu::Pass;
 use super::{Progress, Rendered};

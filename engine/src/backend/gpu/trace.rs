@@ -2,8 +2,8 @@
 //! the CPU's BVH: closest hits and occlusion of given rays through a
 //! frame's geometry, in either hierarchy layout.
 
+use super::BvhLayout;
 use super::GpuBackend;
-use super::bvh::BvhLayout;
 use super::device;
 use super::error::GpuError;
 use super::kernel::{Features, Kernel};

@@ -9,7 +9,8 @@
 //! of [`Surfaces`](crate::extract::Surfaces) are read as they are; the
 //! GPU's own leaf order is a permutation of each bottom level's slots.
 
-use super::bvh::{BvhLayout, build_level};
+use super::BvhLayout;
+use super::bvh::build_level;
 use super::error::GpuError;
 use crate::accel::{Motion, Place, Primitive};
 use crate::extract::{NO_EMITTER, NO_MATERIAL, RenderScene};

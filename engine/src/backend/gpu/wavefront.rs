@@ -27,27 +27,6 @@ use super::{Dispatch, FrameBuffers, GpuBackend, GpuError, UNIFORM_STRIDE, device
 use crate::backend::Progress;
 use wgpu::util::DeviceExt;
 
-/// Which kernel renders the paths on the GPU (`--gpu-kernel`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-pub enum GpuKernel {
-    /// One invocation traces one whole path (`wgsl/path.wgsl`).
-    #[default]
-    Megakernel,
-    /// Paths pass through generate, extend, shade, connect and accumulate
-    /// stages with queues between them (`wgsl/wavefront.wgsl`).
-    Wavefront,
-}
-
-impl std::fmt::Display for GpuKernel {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            GpuKernel::Megakernel => "megakernel",
-            GpuKernel::Wavefront => "wavefront",
-        })
-    }
-}
-
 /// Path slots of the pool at most (twice what an H200 keeps resident at
 /// 64 registers per invocation, so that every stage fills the GPU).
 const POOL: u32 = 1 << 19;

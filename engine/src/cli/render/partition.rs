@@ -62,7 +62,7 @@ pub(super) fn run(
     let samples = partition
         .samples(settings.spp)
         .map_err(|e| miette::miette!("{e}"))?;
-    let gpu_options = radiant::backend::gpu::GpuOptions::default();
+    let gpu_options = radiant::backend::GpuOptions::default();
     let mut backend = choose(args.backend, &gpu_options, s, &mut |note| {
         eprintln!("{note}")
     })

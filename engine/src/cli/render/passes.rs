@@ -7,7 +7,7 @@
 use super::RenderArgs;
 use clap::Args;
 use radiant::backend::progressive::{self, Controls, Limits, Stop};
-use radiant::backend::{BackendKind, Progress, RenderError, Written, cpu};
+use radiant::backend::{BackendKind, Interrupt, Progress, RenderError, Written, cpu};
 use radiant::extract::{Overrides, RenderScene};
 use radiant::film::aov::{self, AovFilm, AovImage, AovSet};
 use radiant::film::denoise::{Denoiser, Guides};
@@ -117,15 +117,6 @@ fn is_exr(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
 }
 
-/// How Ctrl-C reaches a render with planes: the flag it raises, and
-/// whether the frame is one of a sequence's.
-pub(super) struct Interrupt<'a> {
-    /// Raised by Ctrl-C.
-    pub flag: &'a AtomicBool,
-    /// Whether the frame is one of a sequence's.
-    pub sequence: bool,
-}
-
 /// Renders `scene` with its planes on the CPU, denoises it where asked and
 /// writes `path` (atomically); says on stderr how long denoising took.
 /// Where `interrupt` is given and the integrator renders in passes, it
@@ -165,7 +156,7 @@ pub(super) fn write(
             note("interrupted before the first pass ended: nothing written");
             return Ok(written);
         }
-        (Some(samples), Some(i)) if i.sequence => {
+        (Some(samples), Some(i)) if !i.keep => {
             note(&format!(
                 "interrupted: {samples} of {spp} spp of this frame not written (a render with \
                  passes keeps no state for --resume; its file appears only when it is finished)"

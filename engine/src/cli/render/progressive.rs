@@ -22,19 +22,22 @@
 use super::RenderArgs;
 use clap::Args;
 use radiant::backend::progressive::{self, Controls, Limits, Outcome, Stop};
-use radiant::backend::{Backend, Progress, RenderError, Written};
+use radiant::backend::{Backend, Interrupt, Progress, RenderError, Written};
 use radiant::extract::RenderScene;
 use radiant::farm::partial::{self, Header};
 use radiant::farm::resume::{self, state_path};
 use radiant::film::Film;
+use radiant::film::memory::SUM_BYTES;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 /// The largest film (its exact sums) a plain render keeps whole so that
-/// Ctrl-C can write its samples so far: 16 Mpixels; larger frames render
-/// in bands ([`radiant::backend::cpu::write`]), holding little memory.
+/// Ctrl-C can write its samples so far (and a state to resume): 16
+/// Mpixels; larger frames render in bands
+/// ([`radiant::backend::cpu::write_until`]), holding little memory, and
+/// Ctrl-C keeps their finished rows (`banded.rs`).
 const PLAIN_FILM_BYTES: u64 = 1 << 30;
 
 /// Exit status of a render stopped by Ctrl-C (128 + SIGINT, as shells
@@ -59,6 +62,11 @@ pub struct ProgressiveArgs {
     /// one uninterrupted render of that many samples.
     #[arg(long, value_name = "EXR", conflicts_with = "partition")]
     resume: Option<PathBuf>,
+    /// The largest film, in pixels, that a plain render keeps whole
+    /// (default 16 Mpixels, [`PLAIN_FILM_BYTES`]); larger frames render in
+    /// bands. For tests of banded renders on small frames.
+    #[arg(long, hide = true, value_name = "PIXELS")]
+    whole_film_pixels: Option<u64>,
 }
 
 impl ProgressiveArgs {
@@ -278,11 +286,14 @@ pub(super) struct Session {
     /// it is a plain render's, kept for Ctrl-C).
     asked: bool,
     /// Whether Ctrl-C is handled yet: from the start where passes were
-    /// asked for; in a plain render from its first frame in passes (until
-    /// then Ctrl-C quits at once, as it does in a banded render).
+    /// asked for; in a plain render from its first frame in passes or in
+    /// bands on the CPU (until then Ctrl-C quits at once, as it does in a
+    /// render that cannot stop early).
     handling: AtomicBool,
     /// Whether it renders several frames.
     sequence: bool,
+    /// The largest film a plain render keeps whole, in bytes of sums.
+    whole_film_bytes: u64,
 }
 
 /// The session of a progressive render where `args` ask for one, or of a
@@ -305,6 +316,9 @@ pub(super) fn start(args: &RenderArgs) -> miette::Result<Option<Session>> {
         asked: p.is_set(),
         handling: AtomicBool::new(false),
         sequence: args.frames.is_some_and(|(a, b)| b > a),
+        whole_film_bytes: p
+            .whole_film_pixels
+            .map_or(PLAIN_FILM_BYTES, |pixels| pixels.saturating_mul(SUM_BYTES)),
     };
     if session.asked {
         session.handle_interrupts()?;
@@ -329,14 +343,15 @@ impl Session {
     /// Whether this session renders `scene`'s frame: always where passes
     /// were asked for; for a plain render, where it needs no first-hit
     /// planes (`passes`: AOVs, denoising, alpha keep their own path) and its
-    /// whole film fits in memory and in [`PLAIN_FILM_BYTES`].
+    /// whole film fits in memory and in [`PLAIN_FILM_BYTES`] (or
+    /// `--whole-film-pixels`).
     pub(super) fn takes(&self, scene: &RenderScene, passes: bool) -> bool {
-        use radiant::film::memory::{FrameTooLarge, SUM_BYTES};
+        use radiant::film::memory::FrameTooLarge;
         let s = &scene.settings;
         let bytes = u64::from(s.width) * u64::from(s.height) * SUM_BYTES;
         self.asked
             || (!passes
-                && bytes <= PLAIN_FILM_BYTES
+                && bytes <= self.whole_film_bytes
                 && FrameTooLarge::new(s.width, s.height).check().is_ok()
                 && radiant::backend::cpu::passes(scene).is_ok())
     }
@@ -376,13 +391,14 @@ impl Session {
         Ok(written)
     }
 
-    /// Ctrl-C for a render with first-hit planes (`passes.rs`), handled
-    /// from now on.
-    pub(super) fn interrupt(&self) -> miette::Result<super::passes::Interrupt<'_>> {
+    /// Ctrl-C for a render with first-hit planes (`passes.rs`) or in
+    /// bands (`banded.rs`), handled from now on: a frame of a sequence
+    /// keeps nothing when interrupted.
+    pub(super) fn interrupt(&self) -> miette::Result<Interrupt<'_>> {
         self.handle_interrupts()?;
-        Ok(super::passes::Interrupt {
+        Ok(Interrupt {
             flag: &self.interrupt,
-            sequence: self.sequence,
+            keep: !self.sequence,
         })
     }
 
