@@ -10,8 +10,8 @@
 //! both halves afresh with all its samples, and its time is that render's.
 
 use super::metrics::Halves;
-use crate::backend::cpu::{self, Progress, render_samples, render_samples_with_aovs};
 use crate::backend::Backend;
+use crate::backend::cpu::{self, Progress, render_samples, render_samples_with_aovs};
 use crate::error::{SceneError, module_error};
 use crate::extract::RenderScene;
 use crate::film::aov::AovFilm;
