@@ -480,26 +480,6 @@ fn a_medium_in_an_open_mesh_is_a_located_error() {
 }
 
 #[test]
-fn the_gpu_backend_refuses_media_by_name() {
-    // Media have no WGSL yet: a clear error naming them, not an image
-    // without them.
-    let overrides = Overrides {
-        spp: Some(1),
-        ..Default::default()
-    };
-    let scene = radiant_tests::gpu::extract_scene(DARK, &overrides);
-    // The modules' GPU side is gathered before any device work (no adapter
-    // needed to see the refusal).
-    let result = radiant::backend::gpu::modules::Modules::new(&scene);
-    let message = result.err().map(|e| e.to_string()).unwrap_or_default();
-    assert!(
-        message.contains("medium `smoke` (type `homogeneous`)")
-            && message.contains("--backend cpu"),
-        "{message}"
-    );
-}
-
-#[test]
 fn an_emitting_absorber_glows_as_the_closed_form() {
     // A purely absorbing sphere (σa = 1.5, radius 1) of emitted radiance
     // Le, no lights, seen from afar through a 2° field: each ray's chord l

@@ -24,6 +24,12 @@
 //!          fn sample_2d_T(p: u32, pixel: u32, index: u32, dim: u32) -> vec2f
 //!                                           (optional: else two 1D values)
 //! texture: fn texture_T(p: u32, uv: vec2f) -> vec3f
+//! medium:  fn medium_flight_T(p: u32, o: vec3f, d: vec3f, t_max: f32, beta: vec3f,
+//!                             u: vec2f, rng: ptr<function, Stream>) -> MediumFlight
+//!          fn medium_transmittance_T(p: u32, o: vec3f, d: vec3f, t_max: f32,
+//!                                    rng: ptr<function, Stream>) -> vec3f
+//! phase:   fn phase_sample_T(p: u32, wo: vec3f, u: vec2f) -> BsdfSample
+//!          fn phase_eval_T(p: u32, wo: vec3f, wi: vec3f) -> BsdfEval
 //! ```
 //!
 //! with the structures of the Rust traits (directions in the local shading
@@ -44,6 +50,16 @@ use std::borrow::Cow;
 /// the warps of [`crate::warp`]. The kernel declares the parameter buffer
 /// `module_params` that the readers index.
 pub const PRELUDE: &str = include_str!("gpu/prelude.wgsl");
+
+/// The media's shared WGSL ([`MEDIUM`]'s source): `MediumFlight`, the
+/// hashed `Stream`, the coefficients' readers and the homogeneous free
+/// flight of [`crate::medium::free_flight`]. Every medium type requires
+/// it; the backend includes it in every kernel with media.
+pub const MEDIUM: GpuLibrary = GpuLibrary {
+    name: "core::medium",
+    wgsl: include_str!("gpu/medium.wgsl"),
+    requires: &[],
+};
 
 /// WGSL shared by several module types (microfacet maths, Fresnel terms),
 /// included once in a kernel that any of them is in.

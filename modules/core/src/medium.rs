@@ -56,6 +56,11 @@ pub trait Medium: Send + Sync {
     fn profile(&self) -> Profile<'_> {
         Profile::Uniform
     }
+    /// The medium's GPU side (`medium_flight_T`, `medium_transmittance_T`,
+    /// see [`crate::gpu`]), if it has one.
+    fn gpu(&self) -> Option<crate::GpuModule> {
+        None
+    }
 }
 
 /// The spatial variation of a medium's density.
@@ -80,6 +85,11 @@ pub trait Phase: Send + Sync {
     /// Evaluates the phase function (`value`, the same in every channel)
     /// and the density `sample` has for `wi[i]`.
     fn eval(&self, wo: &[Vec3], wi: &[Vec3], out: &mut [BsdfEval]);
+    /// The phase function's GPU side (`phase_sample_T`, `phase_eval_T`,
+    /// see [`crate::gpu`]), if it has one.
+    fn gpu(&self) -> Option<crate::GpuModule> {
+        None
+    }
 }
 
 /// The isotropic phase function's value, 1/4π.

@@ -12,7 +12,8 @@ use radiant_core::glam::{DVec3, Vec3};
 use radiant_core::medium::DensityField;
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BuildContext, Coefficients, Medium, Numbers, ParamDoc, ParamError, Params, Profile, Registry,
+    BuildContext, Coefficients, GpuModule, GpuParams, Medium, Numbers, ParamDoc, ParamError,
+    Params, Profile, Registry,
 };
 
 medium_params!(GridParams {
@@ -235,6 +236,28 @@ impl Medium for Grid {
 
     fn profile(&self) -> Profile<'_> {
         Profile::Field(&self.grid)
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let g = &self.grid;
+        let words = |v: [usize; 3]| {
+            GpuParams::new()
+                .u32(v[0] as u32)
+                .u32(v[1] as u32)
+                .u32(v[2] as u32)
+        };
+        let params = words(g.resolution)
+            .vec3(g.origin)
+            .vec3(g.size)
+            .append(&words(g.cells))
+            .f32s(g.values.iter().copied())
+            .f32s(g.majorants.iter().copied());
+        Some(crate::gpu::medium(
+            "grid",
+            include_str!("grid.wgsl"),
+            &self.coefficients,
+            params,
+        ))
     }
 }
 

@@ -9,7 +9,8 @@ use radiant_core::glam::DVec3;
 use radiant_core::medium::HeightProfile;
 use radiant_core::params::Spanned;
 use radiant_core::{
-    BuildContext, Coefficients, Medium, Numbers, ParamDoc, ParamError, Params, Profile, Registry,
+    BuildContext, Coefficients, GpuModule, GpuParams, Medium, Numbers, ParamDoc, ParamError,
+    Params, Profile, Registry,
 };
 
 medium_params!(HeightFogParams {
@@ -54,6 +55,19 @@ impl Medium for HeightFog {
 
     fn profile(&self) -> Profile<'_> {
         Profile::Height(self.profile)
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        let h = &self.profile;
+        Some(crate::gpu::medium(
+            "height_fog",
+            include_str!("height_fog.wgsl"),
+            &self.coefficients,
+            GpuParams::new()
+                .vec3(h.up)
+                .f32(h.h0 as f32)
+                .f32(h.scale_height as f32),
+        ))
     }
 }
 

@@ -2,7 +2,8 @@
 
 use crate::coefficients::{medium_docs, medium_params};
 use radiant_core::{
-    BuildContext, Coefficients, Medium, ParamDoc, ParamError, Params, Registry, Rgb,
+    BuildContext, Coefficients, GpuModule, GpuParams, Medium, ParamDoc, ParamError, Params,
+    Registry, Rgb,
 };
 
 medium_params!(HomogeneousParams {});
@@ -32,6 +33,15 @@ impl Homogeneous {
 impl Medium for Homogeneous {
     fn coefficients(&self) -> Coefficients {
         self.coefficients
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        Some(crate::gpu::medium(
+            "homogeneous",
+            include_str!("homogeneous.wgsl"),
+            &self.coefficients,
+            GpuParams::new(),
+        ))
     }
 }
 

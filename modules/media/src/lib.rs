@@ -16,6 +16,7 @@
 //! function once per batch of scattering events.
 
 mod coefficients;
+mod gpu;
 mod grid;
 mod height_fog;
 mod homogeneous;

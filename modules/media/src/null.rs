@@ -6,8 +6,8 @@
 
 use radiant_core::glam::Vec3;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, Effects, ModuleInfo, ParamError, Params, Registry, Rgb,
-    ShadeContext, Shader, SurfaceBatch,
+    BsdfEval, BsdfSample, BuildContext, Effects, GpuModule, GpuParams, ModuleInfo, ParamError,
+    Params, Registry, Rgb, ShadeContext, Shader, SurfaceBatch,
 };
 use serde::Deserialize;
 
@@ -50,6 +50,14 @@ impl Shader for Null {
 
     fn effects(&self) -> Effects {
         Effects::DELTA_LOBES | Effects::TRANSMISSION | Effects::NULL_INTERFACE
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        Some(GpuModule::new(
+            "null",
+            include_str!("null.wgsl"),
+            GpuParams::new(),
+        ))
     }
 }
 

@@ -5,8 +5,8 @@ use radiant_core::medium::{ISOTROPIC, henyey_greenstein, sample_henyey_greenstei
 use radiant_core::params::Spanned;
 use radiant_core::warp::square_to_uniform_sphere;
 use radiant_core::{
-    BsdfEval, BsdfSample, BuildContext, ModuleInfo, ParamDoc, ParamError, Params, Phase, Registry,
-    Rgb,
+    BsdfEval, BsdfSample, BuildContext, GpuModule, GpuParams, ModuleInfo, ParamDoc, ParamError,
+    Params, Phase, Registry, Rgb,
 };
 use serde::Deserialize;
 
@@ -37,6 +37,14 @@ impl Phase for Isotropic {
             value: Rgb::splat(ISOTROPIC),
             pdf: ISOTROPIC,
         });
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        Some(GpuModule::new(
+            "isotropic",
+            include_str!("isotropic.wgsl"),
+            GpuParams::new(),
+        ))
     }
 }
 
@@ -70,6 +78,14 @@ impl Phase for HenyeyGreenstein {
                 pdf: p,
             };
         }
+    }
+
+    fn gpu(&self) -> Option<GpuModule> {
+        Some(GpuModule::new(
+            "hg",
+            include_str!("hg.wgsl"),
+            GpuParams::new().f32(self.g),
+        ))
     }
 }
 

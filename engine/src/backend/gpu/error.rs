@@ -45,6 +45,16 @@ pub enum GpuError {
         /// The module type.
         type_name: String,
     },
+    /// The scene needs what the chosen kernel does not do.
+    #[error(
+        "{what} cannot render with the {kernel} GPU kernel; use `--gpu-kernel megakernel` (the default) or `--backend cpu`"
+    )]
+    Unsupported {
+        /// The kernel (`wavefront`).
+        kernel: &'static str,
+        /// What the scene has that it lacks.
+        what: String,
+    },
     /// The generated kernel did not compile.
     #[error("the GPU kernel did not compile{}: {message}", module.as_ref().map(|m| format!(" (in the code of {m})")).unwrap_or_default())]
     Compile {

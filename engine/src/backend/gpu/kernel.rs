@@ -24,6 +24,7 @@ const WIDE_BVH: &str = include_str!("wgsl/cwbvh.wgsl");
 const PATH: &str = include_str!("wgsl/path.wgsl");
 const WAVEFRONT: &str = include_str!("wgsl/wavefront.wgsl");
 const HEADER: &str = include_str!("wgsl/header.wgsl");
+const MEDIUM: &str = include_str!("wgsl/medium.wgsl");
 const LIGHT_SELECTION: &str = include_str!("wgsl/light_selection.wgsl");
 
 /// Features that select blocks of the kernel's own sources.
@@ -50,6 +51,10 @@ pub struct Features {
     pub spatial_lights: bool,
     /// Lights at infinity that escaped rays see.
     pub environment: bool,
+    /// Participating media or `null` boundaries (`wgsl/medium.wgsl`, the
+    /// media's and phase functions' code, shadow rays that return a
+    /// transmittance).
+    pub media: bool,
     /// Counting of traversal work (`--gpu-stats`).
     pub stats: bool,
     /// The wavefront's stages (`wgsl/wavefront.wgsl`, `--gpu-kernel
@@ -77,6 +82,7 @@ impl Features {
             area_lights: modules.area_lights,
             spatial_lights: scene.lights.is_spatial(),
             environment: modules.environment,
+            media: modules.has_media,
             stats: false,
             wavefront: false,
             wide_bvh: geometry.layout == super::BvhLayout::Wide,
@@ -95,6 +101,7 @@ impl Features {
             "AREA_LIGHTS" => self.area_lights,
             "SPATIAL_LIGHTS" => self.spatial_lights,
             "ENVIRONMENT" => self.environment,
+            "MEDIA" => self.media,
             "STATS" => self.stats,
             "WIDE_BVH" => self.wide_bvh,
             "SPLAT" => self.splat,
@@ -114,6 +121,7 @@ impl Features {
             ("area lights", self.area_lights),
             ("spatial light selection", self.spatial_lights),
             ("environment", self.environment),
+            ("participating media", self.media),
             ("filter splatting", self.splat),
             ("wavefront stages", self.wavefront),
             ("compressed wide BVH", self.wide_bvh),
@@ -181,6 +189,12 @@ impl Kernel {
             "the GPU backend's light selection (wgsl/light_selection.wgsl)",
             &preprocess(LIGHT_SELECTION, &features),
         );
+        if features.media {
+            k.part(
+                "the GPU backend's medium stage (wgsl/medium.wgsl)",
+                &preprocess(MEDIUM, &features),
+            );
+        }
         if features.wavefront {
             k.part(
                 "the GPU backend's wavefront stages (wgsl/wavefront.wgsl)",
@@ -276,7 +290,13 @@ impl Kernel {
             ("shader", &modules.shaders),
             ("texture", &modules.textures),
             ("light", &modules.lights),
+            ("medium", &modules.media),
+            ("phase", &modules.phases),
         ];
+        if modules.has_media {
+            // The medium stage's types, with or without media types.
+            add_library(&mut libraries, &radiant_core::gpu::MEDIUM);
+        }
         for (_, types) in kinds {
             for t in &types.types {
                 for lib in t.requires {
@@ -341,7 +361,7 @@ fn add_library(libraries: &mut Vec<GpuLibrary>, lib: &GpuLibrary) {
 }
 
 /// The (tag, identifier) of each type of a kind.
-fn tagged(types: &KindTypes) -> Vec<(u32, &str)> {
+pub(super) fn tagged(types: &KindTypes) -> Vec<(u32, &str)> {
     types
         .types
         .iter()
@@ -354,7 +374,7 @@ fn tagged(types: &KindTypes) -> Vec<(u32, &str)> {
 /// instance's type `T`: directly where the kind has one type, else by a
 /// `switch` on the tag. `entry` is the WGSL expression of the instance's
 /// (tag, offset) pair.
-fn dispatcher(
+pub(super) fn dispatcher(
     out: &mut String,
     signature: &str,
     entry: &str,
@@ -410,9 +430,12 @@ fn dispatchers(m: &Modules) -> String {
         return texture_dispatcher(m, s);
     }
     let material = "vec2u(param_u32(param_u32(H_MATERIALS) + 4u * m), param_u32(param_u32(H_MATERIALS) + 4u * m + 1u))";
+    // With media, the materials' dispatchers are `surface_*`, behind ones
+    // that also take medium events (`media.rs`).
+    let surface = if m.has_media { "surface_" } else { "" };
     dispatcher(
         &mut s,
-        "bsdf_sample(m: u32, s: ShadingPoint, u: vec3f) -> BsdfSample",
+        &format!("{surface}bsdf_sample(m: u32, s: ShadingPoint, u: vec3f) -> BsdfSample"),
         material,
         "bsdf_sample",
         ", s, u",
@@ -420,16 +443,24 @@ fn dispatchers(m: &Modules) -> String {
     );
     dispatcher(
         &mut s,
-        "bsdf_eval(m: u32, s: ShadingPoint, wi: vec3f) -> BsdfEval",
+        &format!("{surface}bsdf_eval(m: u32, s: ShadingPoint, wi: vec3f) -> BsdfEval"),
         material,
         "bsdf_eval",
         ", s, wi",
         &tagged(&m.shaders),
     );
+    let smooth = if m.has_media {
+        "surface_has_smooth_lobes"
+    } else {
+        "material_has_smooth_lobes"
+    };
     let _ = writeln!(
         s,
-        "fn material_has_smooth_lobes(m: u32) -> bool {{\n    return param_u32(param_u32(H_MATERIALS) + 4u * m + 2u) != 0u;\n}}\n"
+        "fn {smooth}(m: u32) -> bool {{\n    return param_u32(param_u32(H_MATERIALS) + 4u * m + 2u) != 0u;\n}}\n"
     );
+    if m.has_media {
+        super::media::dispatchers(m, &mut s);
+    }
     s = texture_dispatcher(m, s);
     if !m.lights.types.is_empty() {
         let light = "vec2u(param_u32(param_u32(H_LIGHTS) + 4u * l), param_u32(param_u32(H_LIGHTS) + 4u * l + 1u))";
@@ -488,15 +519,16 @@ fn dispatchers(m: &Modules) -> String {
 /// `texture_eval`, appended to `s`.
 fn texture_dispatcher(m: &Modules, mut s: String) -> String {
     let texture = "vec2u(param_u32(param_u32(H_TEXTURES) + 4u * id), param_u32(param_u32(H_TEXTURES) + 4u * id + 1u))";
-    dispatcher(
-        &mut s,
-        "texture_eval(id: u32, uv: vec2f) -> vec3f",
-        texture,
-        "texture",
-        ", uv",
-        &tagged(&m.textures),
-    );
-    if m.textures.types.is_empty() {
+    if !m.textures.types.is_empty() {
+        dispatcher(
+            &mut s,
+            "texture_eval(id: u32, uv: vec2f) -> vec3f",
+            texture,
+            "texture",
+            ", uv",
+            &tagged(&m.textures),
+        );
+    } else {
         let _ = writeln!(
             s,
             "fn texture_eval(id: u32, uv: vec2f) -> vec3f {{\n    return vec3f(0.0);\n}}\n"

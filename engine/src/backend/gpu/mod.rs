@@ -19,6 +19,7 @@ mod cwbvh;
 mod device;
 pub mod error;
 pub mod kernel;
+mod media;
 mod light_selection;
 pub mod modules;
 pub mod probe;
@@ -600,6 +601,13 @@ impl GpuBackend {
     fn compile(&mut self, scene: &RenderScene) -> Result<Plan, GpuError> {
         let plan = Plan::with_levels(scene, self.bvh, &mut self.levels)?
             .for_kernel(self.kernel, self.stats);
+        if self.kernel == GpuKernel::Wavefront && plan.kernel.features.media {
+            // Its stages keep no medium state per slot.
+            return Err(GpuError::Unsupported {
+                kernel: "wavefront",
+                what: "participating media or `null` boundaries".into(),
+            });
+        }
         let s = &scene.settings;
         let max_depth = if s.max_depth < 0 {
             UNLIMITED_DEPTH_CAP

@@ -19,7 +19,7 @@ const FILTER_RES: u32 = 64;
 
 /// Words of the header at the start of the parameter buffer (the `H_*`
 /// constants of `wgsl/path.wgsl`).
-const HEADER_WORDS: usize = 19;
+const HEADER_WORDS: usize = 20;
 
 /// One module type of a kind, as the kernel includes it.
 #[derive(Debug, Clone, PartialEq)]
@@ -42,7 +42,7 @@ pub struct KindTypes {
 
 impl KindTypes {
     /// The tag of `module`'s type, adding the type where it is new.
-    fn tag(&mut self, module: &GpuModule) -> u32 {
+    pub(super) fn tag(&mut self, module: &GpuModule) -> u32 {
         match self.types.iter().position(|t| t.ident == module.ident) {
             Some(i) => i as u32,
             None => {
@@ -79,6 +79,14 @@ pub struct Modules {
     /// see (their indices follow the light CDF: header word 12 says where,
     /// word 13 how many).
     pub environment: bool,
+    /// The medium types (where the scene has media or `null` boundaries).
+    pub media: KindTypes,
+    /// The phase function types.
+    pub phases: KindTypes,
+    /// Whether the frame has media or `null` boundaries: the kernel's
+    /// medium stage (`wgsl/medium.wgsl`) and the media table (header word
+    /// 19, `media.rs`).
+    pub has_media: bool,
 }
 
 /// The built-in texture type of constant values.
@@ -115,15 +123,6 @@ impl Modules {
                 .collect::<Vec<_>>()
                 .join(" or ")
         };
-        // Media have no WGSL yet: say so rather than render without them.
-        if scene.effects.contains(radiant_core::Effects::MEDIA) {
-            let name = scene.media.names.join(", ");
-            return Err(GpuError::MissingCode {
-                kind: "medium",
-                name,
-                type_name: type_of(radiant_core::ModuleKind::Medium),
-            });
-        }
         // Camera and sampler: one instance each.
         let camera = scene.camera.gpu().ok_or_else(|| GpuError::MissingCode {
             kind: "camera",
@@ -144,11 +143,14 @@ impl Modules {
         m.materials(scene)?;
         m.textures(&scene.textures, &scene.texture_names)?;
         m.lights(scene)?;
+        if super::media::active(scene) {
+            super::media::gather(&mut m, scene, &type_of)?;
+        }
         Ok(m)
     }
 
     /// Appends `module`'s parameters; returns their offset.
-    fn push(&mut self, module: &GpuModule) -> u32 {
+    pub(super) fn push(&mut self, module: &GpuModule) -> u32 {
         let at = self.params.len() as u32;
         self.params.extend_from_slice(module.params.words());
         at
@@ -347,6 +349,8 @@ impl Modules {
             ("shaders", names(&self.shaders)),
             ("textures", names(&self.textures)),
             ("lights", names(&self.lights)),
+            ("media", names(&self.media)),
+            ("phases", names(&self.phases)),
         ]
     }
 }

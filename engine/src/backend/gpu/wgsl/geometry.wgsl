@@ -448,7 +448,12 @@ fn trace_scene(o: vec3f, d: vec3f, best: ptr<function, Hit>, any: bool) -> bool 
 //#endif
 
 fn closest_hit(o: vec3f, d: vec3f) -> Hit {
-    var best = Hit(FLOAT_MAX, NO_HIT, 0u, 0.0, 0.0);
+    return closest_hit_before(o, d, FLOAT_MAX);
+}
+
+// The closest hit on o + t·d with t < tmax.
+fn closest_hit_before(o: vec3f, d: vec3f, tmax: f32) -> Hit {
+    var best = Hit(tmax, NO_HIT, 0u, 0.0, 0.0);
 //#if INSTANCES
     trace_scene(o, d, &best, false);
 //#else

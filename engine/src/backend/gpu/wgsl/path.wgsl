@@ -41,13 +41,18 @@ override MAX_DEPTH: u32 = 8u;
 override RR_DEPTH: u32 = 5u;
 
 // Sampler dimensions of the camera (film position, lens; under MOTION one
-// more, the path's time in the shutter) and of each bounce.
+// more, the path's time in the shutter) and of each bounce (under MEDIA
+// two more: the hero channel and the distance, medium.wgsl).
 //#if MOTION
 const CAMERA_DIMS: u32 = 5u;
 //#else
 const CAMERA_DIMS: u32 = 4u;
 //#endif
+//#if MEDIA
+const BOUNCE_DIMS: u32 = 10u;
+//#else
 const BOUNCE_DIMS: u32 = 8u;
+//#endif
 const SHADOW_EPSILON: f32 = 1e-4;
 const NO_EMITTER: u32 = 0xffffffffu;
 
@@ -287,7 +292,13 @@ fn scatter(pixel: u32, index: u32, path: ptr<function, PathState>, it: Interacti
     }
     let eta_scale = (*path).eta_scale * bs.eta * bs.eta;
     let survival = beta_max * eta_scale;
-    if (*path).depth + 1u >= RR_DEPTH && survival < 1.0 {
+//#if MEDIA
+    // Roulette counts real vertices, not `null` crossings.
+    let depth = vertices;
+//#else
+    let depth = (*path).depth;
+//#endif
+    if depth + 1u >= RR_DEPTH && survival < 1.0 {
         if sample_1d(pixel, index, base + 6u) >= survival {
             return false;
         }
@@ -302,6 +313,9 @@ fn scatter(pixel: u32, index: u32, path: ptr<function, PathState>, it: Interacti
     return true;
 }
 
+//#if MEDIA
+// (trace_path with media and `null` boundaries is medium.wgsl's.)
+//#else
 // Radiance of one camera path, and its filter weight in w (splatting: its
 // position in the pixel, packed); adds the rays
 // it traced to `rays` (camera and continuation) and `shadow_rays`.
@@ -337,6 +351,7 @@ fn trace_path(px: u32, py: u32, index: u32, rays: ptr<function, u32>, shadow_ray
     }
     return vec4f(path.radiance, filter_weight);
 }
+//#endif
 
 // Adds one path's radiance r.xyz with filter weight r.w to film entry
 // `at` (or stores it in splat entry `at` for the gather pass); false
