@@ -19,13 +19,19 @@ run single-threaded on the same machine, best of 5 passes.
     python3 engine/benches/embree_peer.py --probe target/release/examples/trace_probe \\
         [../shared/data/models/stanford-bunny.obj]
 
-Embree's figures include the binding's cost of a call per ray (a Cython loop
-around ``rtcIntersect1``/``rtcOccluded1``); the script prints that floor,
-measured on one far-away triangle that no ray comes near, so it can be
-subtracted. The rays are drawn from the same distribution, not bit for bit the same
-rays (numpy's generator, not the probe's).
+Embree is called as Radiant is: a whole batch of rays in one call, a C
+loop (``embree_batch.c``, compiled here with ``cc`` against the library the
+``embreex`` wheel ships) calling ``rtcIntersect1``/``rtcOccluded1`` per ray,
+so no per-ray cost of a Python binding is counted (the binding's own loop,
+``EmbreeScene.run``, costs about 20 ns more per ray; ``--binding`` prints
+its figures too). Embree 4's packet calls (``rtcIntersect8``) are not used:
+they pay off for coherent rays, and these are incoherent. The rays are
+drawn from the same distribution, not bit for bit the same rays (numpy's
+generator, not the probe's).
 """
 import argparse
+import ctypes
+import glob
 import os
 import re
 import subprocess
@@ -118,6 +124,55 @@ def time_embree(triangles, rays):
     return best[0] / RAYS * 1e9, best[1] / RAYS * 1e9, build_ms
 
 
+def load_batch(tmp):
+    """The batch driver, compiled into `tmp` against embreex's Embree."""
+    import embreex
+
+    libs = os.path.join(os.path.dirname(os.path.dirname(embreex.__file__)), "embreex.libs")
+    lib = glob.glob(os.path.join(libs, "libembree4*.so*"))[0]
+    src = os.path.join(os.path.dirname(os.path.abspath(__file__)), "embree_batch.c")
+    out = os.path.join(tmp, "embree_batch.so")
+    subprocess.run(["cc", "-O2", "-shared", "-fPIC", "-o", out, src, lib,
+                    f"-Wl,-rpath,{libs}"], check=True)
+    peer = ctypes.CDLL(out)
+    peer.peer_scene.restype = ctypes.c_void_p
+    peer.peer_scene.argtypes = [ctypes.c_void_p, ctypes.c_size_t]
+    peer.peer_release.argtypes = [ctypes.c_void_p]
+    peer.peer_intersect.argtypes = [ctypes.c_void_p] * 3 + [ctypes.c_size_t] + [ctypes.c_void_p] * 2
+    peer.peer_occluded.argtypes = [ctypes.c_void_p] * 4 + [ctypes.c_size_t, ctypes.c_void_p]
+    return peer
+
+
+def time_embree_batch(peer, triangles, rays):
+    """(closest ns/ray, occluded ns/ray, build ms) of Embree called on whole
+    batches from C ([`load_batch`])."""
+    import numpy as np
+
+    tris = np.ascontiguousarray(triangles, dtype=np.float32)
+    start = time.perf_counter()
+    scene = peer.peer_scene(tris.ctypes.data, len(tris))
+    build_ms = (time.perf_counter() - start) * 1e3
+    origins, dirs, dists = (np.ascontiguousarray(a, dtype=np.float32) for a in rays)
+    n = len(origins)
+    hit = np.empty(n, dtype=np.int32)
+    t = np.empty(n, dtype=np.float32)
+    blocked = np.empty(n, dtype=np.uint8)
+    best = [float("inf")] * 2
+    for _ in range(PASSES):
+        t0 = time.perf_counter()
+        peer.peer_intersect(scene, origins.ctypes.data, dirs.ctypes.data, n,
+                            hit.ctypes.data, t.ctypes.data)
+        best[0] = min(best[0], time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        peer.peer_occluded(scene, origins.ctypes.data, dirs.ctypes.data, dists.ctypes.data,
+                           n, blocked.ctypes.data)
+        best[1] = min(best[1], time.perf_counter() - t0)
+    peer.peer_release(scene)
+    print(f"  embree (batch): {int((hit >= 0).sum())} of {n} hit, "
+          f"{int(blocked.sum())} blocked", file=sys.stderr)
+    return best[0] / n * 1e9, best[1] / n * 1e9, build_ms
+
+
 def time_probe(probe, args):
     """{scene name: (closest, occluded) ns/ray} the probe reports for each
     scene it measures (the Cornell box, directly and through a top level,
@@ -137,20 +192,25 @@ def time_probe(probe, args):
     return scenes
 
 
-def report(name, triangles, rays, radiant):
-    """Times Embree on `triangles` and prints it against `radiant`'s
+def report(name, triangles, rays, radiant, peer, binding):
+    """Times Embree on `triangles` (batch from C; with `binding`, also
+    through embreex's per-ray loop) and prints it against `radiant`'s
     (closest, occluded) ns/ray."""
-    e_closest, e_occluded, build_ms = time_embree(triangles, rays)
-    for query, e, r in [("closest", e_closest, radiant[0]),
-                        ("occluded", e_occluded, radiant[1])]:
+    e_closest, e_occluded, build_ms = time_embree_batch(peer, triangles, rays)
+    b = time_embree(triangles, rays) if binding else None
+    for k, (query, e, r) in enumerate([("closest", e_closest, radiant[0]),
+                                       ("occluded", e_occluded, radiant[1])]):
+        extra = f" {b[k]:10.1f} {r / b[k]:10.2f}x" if b else ""
         print(f"{name:24} {len(triangles):9} {query:>9} {e:10.1f} {r:10.1f} "
-              f"{r / e:14.2f}x")
+              f"{r / e:14.2f}x{extra}")
     print(f"  embree build {build_ms:.0f} ms", file=sys.stderr)
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--probe", default="target/release/examples/trace_probe")
+    ap.add_argument("--binding", action="store_true",
+                    help="also time Embree through embreex's per-ray loop")
     ap.add_argument("meshes", nargs="*")
     args = ap.parse_args()
     try:
@@ -162,25 +222,31 @@ def main():
     import numpy as np
 
     rng = np.random.default_rng(12345)
-    far = np.array([[[1e3, 1e3, 1e3], [1e3 + 1e-3, 1e3, 1e3], [1e3, 1e3 + 1e-3, 1e3]]],
-                   dtype=np.float32)
-    floor = time_embree(far, cornell_rays(rng))
-    print(f"embree binding floor (one far-away triangle): {floor[0]:.1f} ns closest, "
-          f"{floor[1]:.1f} ns occluded")
-    print(f"{'scene':24} {'triangles':>9} {'query':>9} {'embree ns':>10} "
-          f"{'radiant ns':>10} {'radiant/embree':>15}")
     with tempfile.TemporaryDirectory() as tmp:
+        peer = load_batch(tmp)
+        far = np.array([[[1e3, 1e3, 1e3], [1e3 + 1e-3, 1e3, 1e3], [1e3, 1e3 + 1e-3, 1e3]]],
+                       dtype=np.float32)
+        floor = time_embree_batch(peer, far, cornell_rays(rng))
+        print(f"embree floor (one far-away triangle, batch from C): {floor[0]:.1f} ns "
+              f"closest, {floor[1]:.1f} ns occluded")
+        if args.binding:
+            floor = time_embree(far, cornell_rays(rng))
+            print(f"embree floor through the binding: {floor[0]:.1f} ns closest, "
+                  f"{floor[1]:.1f} ns occluded")
+        binding = (f" {'binding ns':>10} {'r/binding':>11}" if args.binding else "")
+        print(f"{'scene':24} {'triangles':>9} {'query':>9} {'embree ns':>10} "
+              f"{'radiant ns':>10} {'radiant/embree':>15}{binding}")
         obj = os.path.join(tmp, "cornell-box.obj")
         probe = time_probe(args.probe, ["--cornell-obj", obj])
         rays = cornell_rays(rng)
-        report("cornell-box", load_obj(obj), rays, probe["cornell box"])
+        report("cornell-box", load_obj(obj), rays, probe["cornell box"], peer, args.binding)
         report("cornell-box, top level", load_obj(obj), rays,
-               probe["cornell box through a top level"])
-    for mesh in args.meshes:
-        triangles = load_obj(mesh)
-        name = mesh.rsplit("/", 1)[-1]
-        radiant = time_probe(args.probe, [mesh])[name]
-        report(name, triangles, mesh_rays(triangles, rng), radiant)
+               probe["cornell box through a top level"], peer, args.binding)
+        for mesh in args.meshes:
+            triangles = load_obj(mesh)
+            name = mesh.rsplit("/", 1)[-1]
+            radiant = time_probe(args.probe, [mesh])[name]
+            report(name, triangles, mesh_rays(triangles, rng), radiant, peer, args.binding)
     return 0
 
 

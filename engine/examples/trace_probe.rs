@@ -11,9 +11,15 @@
 //! * Optionally a mesh given on the command line (e.g. the 69k-triangle
 //!   Stanford bunny): rays start on a sphere around the mesh and aim at
 //!   random points of its bounding box; shadow rays end at that point.
+//! * With `--instances N`, also a field of N turned and scaled copies of
+//!   the mesh, instances of one bottom level under a top level: rays from
+//!   near a camera above the field's edge towards random points of the
+//!   field's box.
 //!
 //! Each query runs over the same rays several times; the fastest pass is
 //! reported, which keeps noise from other processes out of the numbers.
+//! `--rays N --passes N --mesh-only` make a run small enough to profile
+//! under callgrind (`--mesh-only` skips the Cornell box).
 //!
 //! `--cornell-obj OUT.obj` also writes the Cornell box's triangles as the
 //! probe traces them (render space) to an OBJ file, so that
@@ -21,7 +27,7 @@
 //! triangles with the same ray distribution.
 //!
 //! ```text
-//! cargo run --release --example trace_probe [-- [--cornell-obj OUT.obj] path/to/mesh.obj]
+//! cargo run --release --example trace_probe [-- [--cornell-obj OUT.obj] [--rays N] [--passes N] [--mesh-only] [--instances N] path/to/mesh.obj]
 //! ```
 
 use anyhow::{Context, Result};
@@ -33,10 +39,22 @@ use std::hint::black_box;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Rays per measurement pass.
-const RAYS: usize = 1_000_000;
-/// Passes per query; the fastest counts.
-const PASSES: usize = 5;
+/// How much to measure: rays per pass and passes per query (the fastest
+/// counts). Fewer of both make a profile under callgrind affordable.
+#[derive(Debug, Clone, Copy)]
+struct Size {
+    rays: usize,
+    passes: usize,
+}
+
+impl Default for Size {
+    fn default() -> Self {
+        Self {
+            rays: 1_000_000,
+            passes: 5,
+        }
+    }
+}
 
 /// A ray query: origin, direction and the distance it is traced to.
 type Query = (Vec3, Vec3, f32);
@@ -71,7 +89,7 @@ impl Lcg {
 /// Times `accel` on closest-hit rays `closest` and shadow rays `shadow`,
 /// as the renderer traces them: in batches ([`Accel::intersect_slots`],
 /// [`Accel::occluded_each`]).
-fn measure(name: &str, accel: &Accel, closest: &[Query], shadow: &[Query]) {
+fn measure(name: &str, accel: &Accel, closest: &[Query], shadow: &[Query], size: Size) {
     let origins: Vec<Vec3> = closest.iter().map(|q| q.0).collect();
     let dirs: Vec<Vec3> = closest.iter().map(|q| q.1).collect();
     let slots: Vec<u32> = (0..closest.len() as u32).collect();
@@ -82,7 +100,7 @@ fn measure(name: &str, accel: &Accel, closest: &[Query], shadow: &[Query]) {
     let shadow_dirs: Vec<Vec3> = shadow.iter().map(|q| q.1 * q.2).collect();
     let mut is_blocked = vec![false; shadow.len()];
     let mut best = [f64::INFINITY; 2];
-    for _ in 0..PASSES {
+    for _ in 0..size.passes {
         let start = Instant::now();
         accel.intersect_slots(&slots, black_box(&origins), &dirs, None, &mut hit);
         best[0] = best[0].min(start.elapsed().as_secs_f64());
@@ -133,21 +151,21 @@ fn write_obj(prims: &[Primitive], path: &Path) -> Result<()> {
 
 /// Rays inside the Cornell box (render space puts the camera at the origin
 /// and the box's centre at z = -3.9); writes its triangles to `obj` if given.
-fn cornell(rng: &mut Lcg, obj: Option<&Path>) -> Result<()> {
+fn cornell(rng: &mut Lcg, obj: Option<&Path>, size: Size) -> Result<()> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/cornell-box.yaml");
     let scene = radiant::scene::load(&path)?;
     let render = extract(&scene, &radiant::builtin_registry(), &Overrides::default())?;
     if let Some(obj) = obj {
         write_obj(render.accel.blases()[0].primitives(), obj)?;
     }
-    let closest: Vec<Query> = (0..RAYS)
+    let closest: Vec<Query> = (0..size.rays)
         .map(|_| {
             let o = (rng.vec3() * 1.8 - 0.9) - Vec3::new(0.0, 0.0, 3.9);
             (o, rng.direction(), f32::INFINITY)
         })
         .collect();
     let shadow: Vec<Query> = closest.iter().map(|&(o, d, _)| (o, d, 0.5)).collect();
-    measure("cornell box", &render.accel, &closest, &shadow);
+    measure("cornell box", &render.accel, &closest, &shadow, size);
     // The same bottom level entered through a top level and an (identity)
     // transform, as it would be without the direct path for static scenes.
     let blas = render.accel.blases()[0].clone();
@@ -160,12 +178,18 @@ fn cornell(rng: &mut Lcg, obj: Option<&Path>) -> Result<()> {
         }],
         BuildQuality::High,
     );
-    measure("cornell box through a top level", &two, &closest, &shadow);
+    measure(
+        "cornell box through a top level",
+        &two,
+        &closest,
+        &shadow,
+        size,
+    );
     Ok(())
 }
 
 /// Rays from a sphere around the mesh at `path` towards its bounding box.
-fn mesh(path: &Path, rng: &mut Lcg) -> Result<()> {
+fn mesh(path: &Path, rng: &mut Lcg, size: Size, instances: Option<usize>) -> Result<()> {
     let mesh = radiant::scene::mesh::load(path, radiant::scene::mesh::MeshOptions::default())
         .map_err(anyhow::Error::msg)?;
     let prims: Vec<Primitive> = mesh
@@ -182,20 +206,89 @@ fn mesh(path: &Path, rng: &mut Lcg) -> Result<()> {
         });
     let centre = (lo + hi) * 0.5;
     let radius = (hi - lo).length();
-    let shadow: Vec<Query> = (0..RAYS)
+    let (closest, shadow) = aimed(rng, size, (lo, hi), |rng| centre + rng.direction() * radius);
+    let name = path.file_name().unwrap_or(path.as_os_str());
+    measure(&name.to_string_lossy(), &accel, &closest, &shadow, size);
+    if let Some(count) = instances {
+        field(&prims, (lo, hi), count, rng, size)?;
+    }
+    Ok(())
+}
+
+/// Rays from the points `from` draws towards uniform points of the box
+/// (`lo`, `hi`): as closest-hit queries, and as shadow rays that end at
+/// those points.
+fn aimed(
+    rng: &mut Lcg,
+    size: Size,
+    (lo, hi): (Vec3, Vec3),
+    from: impl Fn(&mut Lcg) -> Vec3,
+) -> (Vec<Query>, Vec<Query>) {
+    let shadow: Vec<Query> = (0..size.rays)
         .map(|_| {
-            let o = centre + rng.direction() * radius;
+            let o = from(rng);
             let target = lo + rng.vec3() * (hi - lo);
             let d = (target - o).normalize();
             (o, d, (target - o).length())
         })
         .collect();
-    let closest: Vec<Query> = shadow
+    let closest = shadow
         .iter()
         .map(|&(o, d, _)| (o, d, f32::INFINITY))
         .collect();
-    let name = path.file_name().unwrap_or(path.as_os_str());
-    measure(&name.to_string_lossy(), &accel, &closest, &shadow);
+    (closest, shadow)
+}
+
+/// `count` copies of the mesh `prims` (bounds `lo`, `hi`) on a grid, each
+/// turned about the vertical and scaled by 0.8–1.2, as instances of one
+/// bottom level; rays from near a camera above the field's edge towards
+/// uniform points of the field's box (shadow rays end there), as in
+/// `animation_bench instances`.
+fn field(
+    prims: &[Primitive],
+    (lo, hi): (Vec3, Vec3),
+    count: usize,
+    rng: &mut Lcg,
+    size: Size,
+) -> Result<()> {
+    let extent = (hi - lo).max_element();
+    let side = (count as f32).sqrt().ceil() as usize;
+    let spacing = extent * 1.6;
+    let h = spacing * side as f32 / 2.0;
+    let centre = (lo + hi) * 0.5;
+    let instances = (0..count)
+        .map(|i| {
+            let at = Vec3::new(
+                (i % side) as f32 * spacing - h,
+                0.0,
+                (i / side) as f32 * spacing - h,
+            );
+            let m = glam::DMat4::from_scale_rotation_translation(
+                glam::DVec3::splat(0.8 + 0.4 * f64::from(rng.next())),
+                glam::DQuat::from_rotation_y(f64::from(rng.next()) * std::f64::consts::TAU),
+                (at - centre).as_dvec3(),
+            );
+            let place = Placement::new(m).context("a turn and a scale are invertible")?;
+            Ok(Instance {
+                blas: 0,
+                place: Place::Fixed(place),
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let blas = radiant::accel::Blas::build(prims, None, BuildQuality::default_for(prims.len()));
+    let accel = Accel::new(vec![blas], instances, BuildQuality::default_for(count));
+    let camera = Vec3::new(0.0, 2.5 * extent, h + extent);
+    let (box_lo, box_hi) = (Vec3::new(-h, -extent, -h), Vec3::new(h, extent, h));
+    let (closest, shadow) = aimed(rng, size, (box_lo, box_hi), |rng| {
+        camera + (rng.vec3() - 0.5) * extent
+    });
+    measure(
+        &format!("field of {count}"),
+        &accel,
+        &closest,
+        &shadow,
+        size,
+    );
     Ok(())
 }
 
@@ -203,22 +296,46 @@ fn main() -> Result<()> {
     let mut args = std::env::args_os().skip(1);
     let mut cornell_obj: Option<PathBuf> = None;
     let mut mesh_path: Option<PathBuf> = None;
+    let mut size = Size::default();
+    let mut mesh_only = false;
+    let mut instances = None;
+    let count = |args: &mut dyn Iterator<Item = std::ffi::OsString>, flag: &str| {
+        let value = args
+            .next()
+            .with_context(|| format!("{flag} needs a count"))?;
+        value
+            .to_str()
+            .and_then(|v| v.parse::<usize>().ok())
+            .filter(|&n| n > 0)
+            .with_context(|| format!("{flag} {value:?}: not a positive whole number"))
+    };
     while let Some(arg) = args.next() {
         if arg == "--cornell-obj" {
             let out = args.next().context("--cornell-obj needs an output path")?;
             cornell_obj = Some(out.into());
+        } else if arg == "--mesh-only" {
+            mesh_only = true;
+        } else if arg == "--instances" {
+            instances = Some(count(&mut args, "--instances")?);
+        } else if arg == "--rays" {
+            size.rays = count(&mut args, "--rays")?;
+        } else if arg == "--passes" {
+            size.passes = count(&mut args, "--passes")?;
         } else if mesh_path.is_none() {
             mesh_path = Some(arg.into());
         } else {
             anyhow::bail!(
-                "unexpected argument {arg:?}; usage: trace_probe [--cornell-obj OUT.obj] [MESH.obj]"
+                "unexpected argument {arg:?}; usage: trace_probe [--cornell-obj OUT.obj] \
+                 [--rays N] [--passes N] [--mesh-only] [--instances N] [MESH.obj]"
             );
         }
     }
     let mut rng = Lcg(12345);
-    cornell(&mut rng, cornell_obj.as_deref()).context("Cornell box benchmark")?;
+    if !mesh_only {
+        cornell(&mut rng, cornell_obj.as_deref(), size).context("Cornell box benchmark")?;
+    }
     if let Some(path) = mesh_path {
-        mesh(&path, &mut rng).context("mesh benchmark")?;
+        mesh(&path, &mut rng, size, instances).context("mesh benchmark")?;
     }
     Ok(())
 }

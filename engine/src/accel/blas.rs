@@ -1,33 +1,42 @@
 //! The bottom level: one hierarchy over the primitives of a shape (or of
 //! all static shapes together), in that hierarchy's own space.
 //!
-//! Primitives are stored in leaf order, triangles as packets of four
-//! ([`Tri4`]) tested together with SIMD. A deforming mesh is refitted as
+//! Primitives are stored in leaf order, triangles and spheres as packets
+//! of four ([`Tri4`], [`Sphere4`]) tested together with SIMD. A deforming mesh is refitted as
 //! its vertices move ([`Blas::update`]); under motion blur it keeps its
 //! triangles at shutter open and close and intersects them where they are
 //! at each ray's time.
 
 use super::hierarchy::{Hierarchy, Update, UpdatePolicy};
+use super::sphere::Sphere4;
 use super::triangle::{RayPrep, Tri4};
 use super::wide::{Isa, LeafCost, LeafVisitor, RayBoxes};
-use super::{Hit, Primitive, ray_is_valid, sphere};
+use super::{Hit, Primitive, ray_is_valid};
 use crate::settings::BuildQuality;
 use glam::{Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use rayon::prelude::*;
 use std::ops::Range;
 
-/// What a leaf holds: triangles four at a time, or one sphere.
+/// What a leaf holds: triangles or spheres, four at a time.
 #[derive(Debug, Clone, Copy)]
 enum Packet {
     /// Up to four triangles: `count` primitives from `first` on.
     Triangles { tris: Tri4, first: u32, count: u32 },
-    /// A sphere, primitive `prim`.
-    Sphere {
-        centre: Vec3,
-        radius: f32,
-        prim: u32,
+    /// Up to four spheres: `count` primitives from `first` on.
+    Spheres {
+        spheres: Sphere4,
+        first: u32,
+        count: u32,
     },
+}
+
+impl Packet {
+    /// The primitives (leaf-order indices) the packet holds.
+    fn members(&self) -> Range<u32> {
+        let (Packet::Triangles { first, count, .. } | Packet::Spheres { first, count, .. }) = *self;
+        first..first + count
+    }
 }
 
 /// The primitives at shutter close, for geometry that deforms while the
@@ -276,8 +285,8 @@ fn boxes(prims: &[Primitive], close: Option<&[Primitive]>) -> Vec<Option<Aabb>> 
     }
 }
 
-/// Stores one leaf of input primitives `leaf`: triangles first, in
-/// packets of four, then spheres; returns its range of packets.
+/// Stores one leaf of input primitives `leaf`: triangles first, then
+/// spheres, in packets of four; returns its range of packets.
 fn store_leaf(
     leaf: &[u32],
     prims: &[Primitive],
@@ -288,23 +297,22 @@ fn store_leaf(
     let (tris, spheres): (Vec<u32>, Vec<u32>) = leaf
         .iter()
         .partition(|&&i| matches!(prims[i as usize], Primitive::Triangle(_)));
-    for chunk in tris.chunks(4) {
-        let first = order.len() as u32;
-        order.extend_from_slice(chunk);
-        packets.push(Packet::Triangles {
-            tris: pack(chunk.iter().map(|&i| prims[i as usize])),
-            first,
-            count: chunk.len() as u32,
-        });
-    }
-    for &i in &spheres {
-        if let Primitive::Sphere(centre, radius) = prims[i as usize] {
-            packets.push(Packet::Sphere {
-                centre,
-                radius,
-                prim: order.len() as u32,
+    for (group, triangles) in [(&tris, true), (&spheres, false)] {
+        for chunk in group.chunks(4) {
+            let first = order.len() as u32;
+            order.extend_from_slice(chunk);
+            let (members, count) = (chunk.iter().map(|&i| prims[i as usize]), chunk.len() as u32);
+            packets.push(if triangles {
+                let tris = pack(members);
+                Packet::Triangles { tris, first, count }
+            } else {
+                let spheres = pack_spheres(members);
+                Packet::Spheres {
+                    spheres,
+                    first,
+                    count,
+                }
             });
-            order.push(i);
         }
     }
     start..packets.len() as u32
@@ -323,25 +331,33 @@ fn pack(prims: impl Iterator<Item = Primitive>) -> Tri4 {
     Tri4::new(&vertices[..n])
 }
 
-/// Rewrites the triangle packets with the primitives' new shapes `prims`
-/// (input order), keeping the leaf order `order`.
+/// The spheres among `prims` as one packet.
+fn pack_spheres(prims: impl Iterator<Item = Primitive>) -> Sphere4 {
+    let mut spheres = [(Vec3::ZERO, 0.0); 4];
+    let mut n = 0;
+    for p in prims {
+        if let Primitive::Sphere(c, r) = p {
+            spheres[n] = (c, r);
+            n += 1;
+        }
+    }
+    Sphere4::new(&spheres[..n])
+}
+
+/// Rewrites the packets with the primitives' new shapes `prims` (input
+/// order), keeping the leaf order `order`.
 fn repack(packets: &mut [Packet], prims: &[Primitive], order: &[u32]) {
     packets
         .par_iter_mut()
         .with_min_len(1024)
-        .for_each(|packet| match packet {
-            Packet::Triangles { tris, first, count } => {
-                let members = &order[*first as usize..(*first + *count) as usize];
-                *tris = pack(members.iter().map(|&i| prims[i as usize]));
-            }
-            Packet::Sphere {
-                centre,
-                radius,
-                prim,
-            } => {
-                if let Primitive::Sphere(c, r) = prims[order[*prim as usize] as usize] {
-                    (*centre, *radius) = (c, r);
-                }
+        .for_each(|packet| {
+            let range = packet.members();
+            let members = order[range.start as usize..range.end as usize]
+                .iter()
+                .map(|&i| prims[i as usize]);
+            match packet {
+                Packet::Triangles { tris, .. } => *tris = pack(members),
+                Packet::Spheres { spheres, .. } => *spheres = pack_spheres(members),
             }
         });
 }
@@ -351,17 +367,6 @@ fn repack(packets: &mut [Packet], prims: &[Primitive], order: &[u32]) {
 fn closing(close: &[Primitive], order: &[u32], open: &[Packet]) -> Closing {
     let mut packets = open.to_vec();
     repack(&mut packets, close, order);
-    for p in &mut packets {
-        if let Packet::Sphere {
-            centre,
-            radius,
-            prim,
-        } = p
-            && let Primitive::Sphere(c, r) = close[order[*prim as usize] as usize]
-        {
-            (*centre, *radius) = (c, r);
-        }
-    }
     Closing {
         packets,
         prims: order.iter().map(|&i| close[i as usize]).collect(),
@@ -415,7 +420,7 @@ impl<'a, const MOVING: bool> Query<'a, MOVING> {
         }
         match &self.closing[i] {
             Packet::Triangles { tris: end, .. } => tris.lerp(end, self.tau),
-            Packet::Sphere { .. } => *tris,
+            Packet::Spheres { .. } => *tris,
         }
     }
 }
@@ -444,16 +449,14 @@ impl<const MOVING: bool> LeafVisitor for Query<'_, MOVING> {
                         };
                     }
                 }
-                Packet::Sphere {
-                    centre,
-                    radius,
-                    prim,
+                Packet::Spheres {
+                    ref spheres, first, ..
                 } => {
-                    if let Some(t) = hit_sphere(self.origin, self.dir, centre, radius, tmax) {
+                    if let Some((lane, t)) = hit_spheres(spheres, self.origin, self.dir, tmax) {
                         tmax = t;
                         self.best = Hit {
                             t,
-                            prim: self.base + prim,
+                            prim: self.base + first + lane as u32,
                             inst: 0,
                             b1: 0.0,
                             b2: 0.0,
@@ -476,8 +479,8 @@ impl<const MOVING: bool> LeafVisitor for Query<'_, MOVING> {
                         tris.any(self.prep, tmax)
                     }
                 }
-                Packet::Sphere { centre, radius, .. } => {
-                    hit_sphere(self.origin, self.dir, centre, radius, tmax).is_some()
+                Packet::Spheres { ref spheres, .. } => {
+                    any_sphere(spheres, self.origin, self.dir, tmax)
                 }
             };
             if hit {
@@ -488,11 +491,17 @@ impl<const MOVING: bool> LeafVisitor for Query<'_, MOVING> {
     }
 }
 
-/// [`sphere::intersect`], kept out of the triangle loops so that they
+/// [`Sphere4::closest`], kept out of the triangle loops so that they
 /// keep their registers (triangles are by far the common case).
 #[inline(never)]
-fn hit_sphere(origin: Vec3, dir: Vec3, centre: Vec3, radius: f32, tmax: f32) -> Option<f32> {
-    sphere::intersect(origin, dir, centre, radius, tmax)
+fn hit_spheres(spheres: &Sphere4, origin: Vec3, dir: Vec3, tmax: f32) -> Option<(usize, f32)> {
+    spheres.closest(origin, dir, tmax)
+}
+
+/// [`Sphere4::any`], out of line as [`hit_spheres`].
+#[inline(never)]
+fn any_sphere(spheres: &Sphere4, origin: Vec3, dir: Vec3, tmax: f32) -> bool {
+    spheres.any(origin, dir, tmax)
 }
 
 /// The box of `p`, or `None` where a coordinate is not finite.
@@ -559,11 +568,7 @@ mod tests {
             match items {
                 Some(range) => {
                     for packet in &blas.packets[range.clone()] {
-                        let members = match *packet {
-                            Packet::Triangles { first, count, .. } => first..first + count,
-                            Packet::Sphere { prim, .. } => prim..prim + 1,
-                        };
-                        for i in members {
+                        for i in packet.members() {
                             let p = prims[blas.order[i as usize] as usize];
                             let b = p.aabb().expect("finite primitives");
                             assert!(inside(aabb, &b), "{b:?} outside its leaf {aabb:?}");
@@ -662,7 +667,8 @@ mod tests {
                         .closest(&prep, f32::INFINITY)
                         .map(|h| (h.t, i as u32)),
                     Primitive::Sphere(c, r) => {
-                        sphere::intersect(o, d, *c, *r, f32::INFINITY).map(|t| (t, i as u32))
+                        crate::accel::sphere::intersect(o, d, *c, *r, f32::INFINITY)
+                            .map(|t| (t, i as u32))
                     }
                 })
                 .min_by(|a, b| a.0.total_cmp(&b.0));

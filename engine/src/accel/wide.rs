@@ -579,7 +579,17 @@ impl WideBvh {
                 leaves &= !(1 << lane);
                 tmax = leaf.closest(node.items(lane), tmax);
             }
-            stack.push_lanes(node, mask & !leaf_lanes, &t_near, true);
+            let inner = mask & !leaf_lanes;
+            if inner != 0 && inner & (inner - 1) == 0 {
+                // One child: straight down, without the stack's round trip.
+                let lane = inner.trailing_zeros() as usize;
+                if t_near[lane] <= tmax * FAR_SCALE {
+                    current = node.child[lane] as usize;
+                    continue;
+                }
+            } else {
+                stack.push_lanes(node, inner, &t_near, true);
+            }
             // Next: the nearest pending node that is not beyond the hit.
             loop {
                 let Some(e) = stack.pop() else { return };
