@@ -143,6 +143,43 @@ fn grid_walk_next(p: u32, w: ptr<function, GridWalk>) -> vec3f {
     return vec3f(0.0, 0.0, -1.0);
 }
 
+// Tentative collisions along a walk: exponential steps at the rate
+// μ̄ = ρ̄·top of each majorant segment.
+struct Collisions {
+    walk: GridWalk,
+    t: f32,
+    end: f32,
+    mu: f32,
+}
+
+fn grid_collisions(p: u32, o: vec3f, d: vec3f, t_max: f32) -> Collisions {
+    return Collisions(grid_walk(p, o, d, t_max), 0.0, 0.0, 0.0);
+}
+
+// Moves `c` to its next tentative collision (c.t, at rate c.mu); false
+// where the walk has ended.
+fn grid_next_collision(p: u32, c: ptr<function, Collisions>, top: f32, rng: ptr<function, Stream>) -> bool {
+    loop {
+        if (*c).mu > 0.0 {
+            // 1 − u in (0, 1]: the logarithm is finite.
+            (*c).t -= log(1.0 - stream_next(rng)) / (*c).mu;
+            if (*c).t < (*c).end {
+                return true;
+            }
+        }
+        var walk = (*c).walk;
+        let seg = grid_walk_next(p, &walk);
+        (*c).walk = walk;
+        if seg.z < 0.0 {
+            return false;
+        }
+        (*c).t = seg.x;
+        (*c).end = seg.y;
+        (*c).mu = seg.z * top;
+    }
+    return false;
+}
+
 // Spectral delta tracking (`delta_track`): tentative collisions at the
 // grey majorant rate μ̄ = ρ̄·max σt, absorption, scattering or a null
 // collision chosen by the channel averages of σa·β, σs·β and σn·β
@@ -158,49 +195,39 @@ fn medium_flight_grid(p: u32, o: vec3f, d: vec3f, t_max: f32, beta: vec3f, u: ve
         return out;
     }
     let emits = max(emission.x, max(emission.y, emission.z)) > 0.0 && max(sigma_a.x, max(sigma_a.y, sigma_a.z)) > 0.0;
-    var w = grid_walk(p, o, d, t_max);
+    var c = grid_collisions(p, o, d, t_max);
     loop {
-        let seg = grid_walk_next(p, &w);
-        if seg.z < 0.0 {
+        if !grid_next_collision(p, &c, top, rng) {
             break;
         }
-        let mu = seg.z * top;
-        if mu <= 0.0 {
-            continue;
+        let t = c.t;
+        let mu = c.mu;
+        let rho = grid_density(p, o + d * t);
+        let sa = sigma_a * rho;
+        let ss = sigma_s * rho;
+        let sn = max(vec3f(mu) - sigma_t * rho, vec3f(0.0));
+        let b = out.beta;
+        if emits {
+            out.emitted += b * sa * emission / mu;
         }
-        var t = seg.x;
-        loop {
-            t -= log(1.0 - stream_next(rng)) / mu;
-            if t >= seg.y {
-                break;
-            }
-            let rho = grid_density(p, o + d * t);
-            let sa = sigma_a * rho;
-            let ss = sigma_s * rho;
-            let sn = max(vec3f(mu) - sigma_t * rho, vec3f(0.0));
-            let b = out.beta;
-            if emits {
-                out.emitted += b * sa * emission / mu;
-            }
-            let pa = channel_average(sa * b);
-            let ps = channel_average(ss * b);
-            let pn = channel_average(sn * b);
-            let total = pa + ps + pn;
-            let x = stream_next(rng) * total;
-            if total <= 0.0 || x < pa {
-                // Absorbed: the path ends here.
-                out.beta = vec3f(0.0);
-                out.t = t;
-                return out;
-            }
-            if x < pa + ps {
-                out.beta = b * ss * (total / (mu * ps));
-                out.t = t;
-                out.scattered = true;
-                return out;
-            }
-            out.beta = b * sn * (total / (mu * pn));
+        let pa = channel_average(sa * b);
+        let ps = channel_average(ss * b);
+        let pn = channel_average(sn * b);
+        let total = pa + ps + pn;
+        let x = stream_next(rng) * total;
+        if total <= 0.0 || x < pa {
+            // Absorbed: the path ends here.
+            out.beta = vec3f(0.0);
+            out.t = t;
+            return out;
         }
+        if x < pa + ps {
+            out.beta = b * ss * (total / (mu * ps));
+            out.t = t;
+            out.scattered = true;
+            return out;
+        }
+        out.beta = b * sn * (total / (mu * pn));
     }
     return out;
 }
@@ -214,33 +241,21 @@ fn medium_transmittance_grid(p: u32, o: vec3f, d: vec3f, t_max: f32, rng: ptr<fu
     if top <= 0.0 {
         return tr;
     }
-    var w = grid_walk(p, o, d, t_max);
+    var c = grid_collisions(p, o, d, t_max);
     loop {
-        let seg = grid_walk_next(p, &w);
-        if seg.z < 0.0 {
-            return tr;
+        if !grid_next_collision(p, &c, top, rng) {
+            break;
         }
-        let mu = seg.z * top;
-        if mu <= 0.0 {
-            continue;
+        tr *= max(vec3f(1.0) - sigma_t * (grid_density(p, o + d * c.t) / c.mu), vec3f(0.0));
+        let m = max(tr.x, max(tr.y, tr.z));
+        if m <= 0.0 {
+            return vec3f(0.0);
         }
-        var t = seg.x;
-        loop {
-            t -= log(1.0 - stream_next(rng)) / mu;
-            if t >= seg.y {
-                break;
-            }
-            tr *= max(vec3f(1.0) - sigma_t * (grid_density(p, o + d * t) / mu), vec3f(0.0));
-            let m = max(tr.x, max(tr.y, tr.z));
-            if m <= 0.0 {
+        if m < 0.05 {
+            if stream_next(rng) < 0.75 {
                 return vec3f(0.0);
             }
-            if m < 0.05 {
-                if stream_next(rng) < 0.75 {
-                    return vec3f(0.0);
-                }
-                tr *= 4.0;
-            }
+            tr *= 4.0;
         }
     }
     return tr;
