@@ -436,7 +436,10 @@ fn an_interrupted_banded_render_keeps_its_finished_rows() {
     let e = stderr(&o);
     assert_eq!(o.status.code(), Some(130), "{e}");
     let rows = number_after(&e, "interrupted: the top ") as usize;
-    assert!(rows > 0 && rows < 512 && rows.is_multiple_of(128), "{rows}: {e}");
+    assert!(
+        rows > 0 && rows < 512 && rows.is_multiple_of(128),
+        "{rows}: {e}"
+    );
     let samples = rows * 64 * spp.parse::<usize>().unwrap();
     assert!(
         e.contains(&format!(
