@@ -95,6 +95,11 @@ CORNELL_CAMERA = {"fov": 39.3077, "fov_axis": "smaller",
                   "origin": [0, 0, 3.9], "target": [0, 0, 0], "up": [0, 1, 0]}
 
 
+# Radiant's sampler in the written scenes: its default (scenes without a
+# `sampler` block get it), Owen-scrambled Sobol points.
+RADIANT_SAMPLER = "sobol"
+
+
 def rect(name, transform, material, emitter=None):
     return {"name": name, "type": "rectangle", "transform": transform,
             "material": material, "emitter": emitter}
@@ -301,7 +306,7 @@ def radiant_yaml(name, s):
               f"integrator: {{type: path, max_depth: {MAX_DEPTH}}}",
               "film:", f"  width: {W}", f"  height: {H}",
               "  filter: {type: gaussian, stddev: 0.5}",
-              f"sampler: {{type: independent, spp: {s['spp']}}}"]
+              f"sampler: {{type: {RADIANT_SAMPLER}, spp: {s['spp']}}}"]
     c = s["camera"]
     lines += ["camera:", "  type: perspective", f"  fov: {c['fov']}", f"  fov_axis: {c['fov_axis']}",
               f"  look_at: {{origin: {yaml_value(c['origin'])}, target: {yaml_value(c['target'])}, "
@@ -410,7 +415,7 @@ def mitsuba_dict(mi, s, spp):
                                                        up=c["up"]),
             "film": {"type": "hdrfilm", "width": W, "height": H,
                      "rfilter": {"type": "gaussian", "stddev": 0.5}, "pixel_format": "rgb"},
-            "sampler": {"type": "independent", "sample_count": spp},
+            "sampler": {"type": "independent", "sample_count": spp},  # `--mitsuba-sampler`
         },
     }
     for i, sh in enumerate(s["shapes"]):
@@ -489,13 +494,15 @@ def ref_paths(name):
     return (os.path.join(REFS, f"{name}.exr"), os.path.join(REFS, f"{name}.halfdiff.exr"))
 
 
-def load_scene(mi, name, s, spp):
+def load_scene(mi, name, s, spp, sampler="independent"):
     if name == "cornell-box":
         desc = mi.cornell_box()
         desc["integrator"]["max_depth"] = MAX_DEPTH
-        desc["sensor"]["sampler"]["sample_count"] = spp
-        return mi.load_dict(desc)
-    return mi.load_dict(mitsuba_dict(mi, s, spp))
+    else:
+        desc = mitsuba_dict(mi, s, spp)
+    desc["sensor"]["sampler"]["sample_count"] = spp
+    desc["sensor"]["sampler"]["type"] = sampler
+    return mi.load_dict(desc)
 
 
 def selected(args):
@@ -564,18 +571,27 @@ def radiant_run(binary, scene, spp, seed, threads, out, extra):
     return float(m.group(4))
 
 
-def with_light_selection(yaml, selection):
+def scene_variant(yaml, selection="", sampler=""):
     """A copy of the scene `yaml` beside it (so relative paths hold) whose
-    integrator selects lights by `selection`; git ignores it."""
+    integrator selects lights by `selection` and whose sampler is `sampler`
+    (each unchanged where empty); git ignores it."""
     with open(yaml) as f:
         text = f.read()
-    text, n = re.subn(r"^integrator: \{type: path, ", f"integrator: {{type: path, light_selection: {selection}, ",
-                      text, flags=re.M)
-    if n == 0:  # the Cornell box's block form
-        text, n = re.subn(r"^  type: path$", f"  type: path\n  light_selection: {selection}", text,
+    if selection:
+        text, n = re.subn(r"^integrator: \{type: path, ",
+                          f"integrator: {{type: path, light_selection: {selection}, ", text,
                           flags=re.M)
-    if n != 1:
-        sys.exit(f"cannot set light_selection in {yaml}")
+        if n == 0:  # the Cornell box's block form
+            text, n = re.subn(r"^  type: path$", f"  type: path\n  light_selection: {selection}",
+                              text, flags=re.M)
+        if n != 1:
+            sys.exit(f"cannot set light_selection in {yaml}")
+    if sampler:
+        text, n = re.subn(r"^sampler: \{type: \w+", f"sampler: {{type: {sampler}", text, flags=re.M)
+        if n == 0:  # block form
+            text, n = re.subn(r"^(sampler:\n  type:) \w+", f"\\1 {sampler}", text, flags=re.M)
+        if n != 1:
+            sys.exit(f"cannot set the sampler in {yaml}")
     # scenes/bench/ (the Cornell box names no files, so it may move there).
     out = os.path.join(BENCH, f".suite-{os.path.basename(yaml)}")
     with open(out, "w") as f:
@@ -601,9 +617,9 @@ def cmd_bench(args):
         spp = args.spp or s["spp"]
         yaml = (os.path.join(ROOT, "scenes", "cornell-box.yaml") if name == "cornell-box"
                 else os.path.join(BENCH, f"{name}.yaml"))
-        if args.light_selection:
-            yaml = with_light_selection(yaml, args.light_selection)
-        scene = load_scene(mi, name, s, spp)
+        if args.light_selection or args.sampler:
+            yaml = scene_variant(yaml, args.light_selection, args.sampler)
+        scene = load_scene(mi, name, s, spp, args.mitsuba_sampler)
         img = mi.render(scene, spp=spp, seed=999)  # compiles the kernel
         dr.eval(img)
         rt, mt, rerr, merr = [], [], [], []
@@ -627,7 +643,9 @@ def cmd_bench(args):
     threads = args.threads or os.cpu_count()
     print(f"\n{W}x{H}, max_depth {MAX_DEPTH}, {threads} threads, medians of {args.runs} "
           f"interleaved runs; {cpu_summary()}"
-          + (f"; Radiant with light_selection: {args.light_selection}" if args.light_selection else ""))
+          + (f"; Radiant with light_selection: {args.light_selection}" if args.light_selection else "")
+          + (f"; Radiant's sampler: {args.sampler}" if args.sampler else "")
+          + f"; Mitsuba's sampler: {args.mitsuba_sampler}")
     print("| scene | spp | Radiant s | Mitsuba s | speed | MSE Radiant | MSE Mitsuba | at equal error |")
     print("|---|---|---|---|---|---|---|---|")
     speeds, equal = [], []
@@ -672,7 +690,7 @@ def cmd_profile(args):
         yaml = (os.path.join(ROOT, "scenes", "cornell-box.yaml") if name == "cornell-box"
                 else os.path.join(BENCH, f"{name}.yaml"))
         if args.light_selection:
-            yaml = with_light_selection(yaml, args.light_selection)
+            yaml = scene_variant(yaml, args.light_selection)
         data = f"/tmp/radiant-profile-{name}.data"
         cmd = ["perf", "record", "-F", "1999", "-o", data, "--", args.radiant, "render", yaml,
                "--spp", str(args.spp), "--threads", "1", "-o", f"/tmp/radiant-profile-{name}.exr"]
@@ -722,6 +740,12 @@ def main():
     b.add_argument("--spp", type=int, default=0, help="override every scene's spp")
     b.add_argument("--light-selection", default="",
                    help="run Radiant with this integrator light_selection (power, uniform, spatial)")
+    b.add_argument("--sampler", default="",
+                   help="run Radiant with this sampler (default: each scene's own, sobol in "
+                        "scenes/bench, independent in the Cornell box)")
+    b.add_argument("--mitsuba-sampler", default="independent",
+                   help="Mitsuba's sampler (independent, its default; or ldsampler, multijitter, "
+                        "orthogonal, stratified)")
     b.add_argument("--radiant-args", default="",
                    help="extra arguments for radiant render (one string)")
     pr = sub.add_parser("profile", help="perf profile of each scene on one thread")

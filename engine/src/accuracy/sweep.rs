@@ -512,7 +512,7 @@ mod tests {
                 "filter=tent",
                 "filter_sampling=importance",
                 "sampler=halton",
-                "sampler=sobol",
+                "sampler=independent",
                 "sampler=stratified",
                 "bvh=fast",
                 "bvh=medium"
@@ -539,7 +539,7 @@ mod tests {
                 "baseline",
                 "sampler=constant",
                 "sampler=halton",
-                "sampler=sobol",
+                "sampler=independent",
                 "sampler=stratified",
                 "light_selection=power",
                 "light_selection=uniform"
@@ -558,9 +558,6 @@ mod tests {
             };
             assert_eq!(r.settings.light_selection, expected);
         }
-        assert_eq!(
-            two.sampler.type_name, "independent",
-            "the scene is restored"
-        );
+        assert_eq!(two.sampler.type_name, "sobol", "the scene is restored");
     }
 }

@@ -145,8 +145,8 @@ pub const SCENE_KEYS: &[KeyDocs] = &[
             key(
                 "type",
                 "sampler",
-                "independent",
-                "The sampler module (see samplers above).",
+                "sobol (without a `sampler` block)",
+                "The sampler module (see samplers above); a `sampler` block names one.",
             ),
             key(
                 "spp",

@@ -78,6 +78,14 @@ pub fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
     laine_karras(x.reverse_bits(), seed).reverse_bits()
 }
 
+/// [`nested_uniform_scramble`] of `x.reverse_bits()`, computed without the
+/// two bit reversals that cancel: the Owen scramble of the fraction whose
+/// bits, most significant first, are `x`'s bits from the least significant.
+#[inline]
+pub fn nested_uniform_scramble_reversed(x: u32, seed: u32) -> u32 {
+    laine_karras(x, seed).reverse_bits()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -92,6 +100,18 @@ mod tests {
                     assert!(p < n && !seen[p as usize], "n {n} key {key}");
                     seen[p as usize] = true;
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn the_reversed_scramble_is_the_scramble_of_the_reversal() {
+        for seed in [0u32, 3, 0xdead_beef] {
+            for x in [0u32, 1, 0x8000_0000, 0x1234_5678, u32::MAX] {
+                assert_eq!(
+                    nested_uniform_scramble_reversed(x, seed),
+                    nested_uniform_scramble(x.reverse_bits(), seed)
+                );
             }
         }
     }

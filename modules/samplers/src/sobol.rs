@@ -12,10 +12,10 @@
 //! two are best.
 
 use crate::pointwise::{Pointwise, pointwise_sampler};
-use crate::scramble::{SCRAMBLE_WGSL, nested_uniform_scramble};
+use crate::scramble::{SCRAMBLE_WGSL, nested_uniform_scramble, nested_uniform_scramble_reversed};
 use crate::seed::fold;
 use radiant_core::glam::Vec2;
-use radiant_core::hash::{hash_u32, hash4, unit_float};
+use radiant_core::hash::{hash_u32, hash4_first, hash4_last, hash4_middle, unit_float};
 use radiant_core::{GpuModule, GpuParams, Registry, SampleId};
 
 /// Direction numbers of the second Sobol dimension: v₀ = 2³¹,
@@ -33,17 +33,15 @@ const fn directions_1() -> [u32; 32] {
     v
 }
 
-/// The second Sobol dimension of `index`, as a 32-bit fraction.
+/// The second Sobol dimension of `index`, as a 32-bit fraction: the XOR of
+/// the direction numbers of `index`'s set bits, without branches (a
+/// shuffled index has random high bits, so a loop over them would
+/// mispredict, and a branchless one vectorises across a batch).
 #[inline]
-fn sobol_1(mut index: u32) -> u32 {
+fn sobol_1(index: u32) -> u32 {
     let mut x = 0;
-    let mut bit = 0;
-    while index != 0 {
-        if index & 1 != 0 {
-            x ^= DIRECTIONS_1[bit];
-        }
-        index >>= 1;
-        bit += 1;
+    for (bit, v) in DIRECTIONS_1.iter().enumerate() {
+        x ^= v & 0u32.wrapping_sub((index >> bit) & 1);
     }
     x
 }
@@ -52,30 +50,36 @@ fn sobol_1(mut index: u32) -> u32 {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Sobol {
     seed: u32,
+    /// `hash4_first(seed)`: the keys' hash state after the seed.
+    seed_state: u32,
 }
 
 impl Sobol {
     /// A Sobol sampler for the render seed `seed`.
     pub fn new(seed: u64) -> Self {
-        Self { seed: fold(seed) }
+        let seed = fold(seed);
+        Self {
+            seed,
+            seed_state: hash4_first(seed),
+        }
     }
 }
 
 impl Pointwise for Sobol {
     #[inline]
     fn value_2d(&self, id: SampleId, dim: u32) -> Vec2 {
-        let key = hash4(self.seed, id.pixel, dim, 0x3c6e_f372);
+        let key = hash4_last(hash4_middle(self.seed_state, id.pixel, dim), 0x3c6e_f372);
         let i = nested_uniform_scramble(id.index, key);
-        let x = nested_uniform_scramble(i.reverse_bits(), hash_u32(key ^ 0x1));
+        let x = nested_uniform_scramble_reversed(i, hash_u32(key ^ 0x1));
         let y = nested_uniform_scramble(sobol_1(i), hash_u32(key ^ 0x2));
         Vec2::new(unit_float(x), unit_float(y))
     }
 
     #[inline]
     fn value_1d(&self, id: SampleId, dim: u32) -> f32 {
-        let key = hash4(self.seed, id.pixel, dim, 0xa54f_f53a);
+        let key = hash4_last(hash4_middle(self.seed_state, id.pixel, dim), 0xa54f_f53a);
         let i = nested_uniform_scramble(id.index, key);
-        unit_float(nested_uniform_scramble(i.reverse_bits(), hash_u32(key)))
+        unit_float(nested_uniform_scramble_reversed(i, hash_u32(key)))
     }
 
     fn gpu(&self) -> Option<GpuModule> {

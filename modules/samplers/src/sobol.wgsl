@@ -7,17 +7,15 @@ fn sample_1d_sobol(p: u32, pixel: u32, index: u32, dim: u32) -> f32 {
     return unit_float(smp_owen_scramble(reverseBits(i), hash_u32(key)));
 }
 
-// The second Sobol dimension of `index` (sobol.rs `sobol_1`): direction
-// numbers v₀ = 2³¹, vᵢ = vᵢ₋₁ ⊕ (vᵢ₋₁ ≫ 1).
-fn smp_sobol_1(index0: u32) -> u32 {
-    var index = index0;
+// The second Sobol dimension of `index` (sobol.rs `sobol_1`): the XOR of
+// the direction numbers v₀ = 2³¹, vᵢ = vᵢ₋₁ ⊕ (vᵢ₋₁ ≫ 1) of the set bits,
+// without branches (a shuffled index has random high bits: a loop that
+// stopped at the last set bit would diverge across a workgroup).
+fn smp_sobol_1(index: u32) -> u32 {
     var x = 0u;
     var v = 0x80000000u;
-    while index != 0u {
-        if (index & 1u) != 0u {
-            x ^= v;
-        }
-        index >>= 1u;
+    for (var bit = 0u; bit < 32u; bit++) {
+        x ^= v & (0u - ((index >> bit) & 1u));
         v ^= v >> 1u;
     }
     return x;
