@@ -49,7 +49,7 @@ pub struct FilterTable {
     values: Vec<f32>,
     /// For a separable filter f(x, y) = g(x)·g(y): g tabulated over [0, r],
     /// so a splat computes one row and one column of weights.
-    separable: Option<Vec<f32>>,
+    separable: Option<Box<[f32; TABLE_RES]>>,
 }
 
 impl FilterTable {
@@ -99,7 +99,7 @@ impl FilterTable {
     /// The separable factor g at offset `d` (0 outside the support);
     /// `factor` is `separable`.
     #[inline(always)]
-    fn factor(&self, factor: &[f32], d: f32) -> f32 {
+    fn factor(&self, factor: &[f32; TABLE_RES], d: f32) -> f32 {
         self.index(d).map_or(0.0, |i| factor[i])
     }
 
@@ -115,7 +115,7 @@ impl FilterTable {
         px0: i32,
         taps: usize,
         wx: &mut [f32; MAX_TAPS],
-    ) -> Option<&[f32]> {
+    ) -> Option<&[f32; TABLE_RES]> {
         let g = self.separable.as_deref().filter(|_| taps <= MAX_TAPS)?;
         for (x, w) in (px0..).zip(&mut wx[..taps]) {
             *w = self.factor(g, x as f32 + 0.5 - pos_x);
@@ -126,13 +126,13 @@ impl FilterTable {
 
 /// If the table is the outer product g(x)·g(y) of one function with itself
 /// (box, tent, gaussian and the usual windowed filters are), returns g.
-fn separable_factor(values: &[f32]) -> Option<Vec<f32>> {
+fn separable_factor(values: &[f32]) -> Option<Box<[f32; TABLE_RES]>> {
     let centre = values[0];
     if centre <= 0.0 {
         return None;
     }
     let norm = centre.sqrt();
-    let g: Vec<f32> = values[..TABLE_RES].iter().map(|v| v / norm).collect();
+    let g: Box<[f32; TABLE_RES]> = Box::new(std::array::from_fn(|i| values[i] / norm));
     let max = values.iter().fold(0.0f32, |m, v| m.max(v.abs()));
     let tolerance = 1e-5 * max;
     let product_matches = (0..TABLE_RES).all(|iy| {
@@ -272,16 +272,20 @@ impl TileFilm {
         // One row of weights, reused on every row of pixels.
         let mut wx = [0.0f32; MAX_TAPS];
         if let Some(g) = table.separable_row(pos.x, px0, taps, &mut wx) {
-            let mut start = self.bounds.index(px0, py0);
-            for y in py0..=py1 {
-                let vy = v * table.factor(g, y as f32 + 0.5 - pos.y);
-                for (sum, &w) in self.current[start..start + taps]
-                    .iter_mut()
-                    .zip(&wx[..taps])
-                {
-                    *sum += vy * w;
-                }
-                start += self.bounds.width as usize;
+            let start = self.bounds.index(px0, py0);
+            let rows = RowSplat {
+                start,
+                py0,
+                py1,
+                pos_y: pos.y,
+                v,
+            };
+            // A Gaussian of radius 2 (Mitsuba's default filter) covers 4
+            // or 5 columns: unrolled rows for those.
+            match taps {
+                4 => self.splat_rows::<4>(&rows, &wx, g, table),
+                5 => self.splat_rows::<5>(&rows, &wx, g, table),
+                _ => self.splat_rows_any(&rows, taps, &wx, g, table),
             }
             return;
         }
@@ -295,6 +299,52 @@ impl TileFilm {
                     row[(x - b.x0) as usize] += v * w;
                 }
             }
+        }
+    }
+
+    /// The rows of a separable splat with `N` columns of weights `wx`:
+    /// each pixel adds (v·g(row))·w, as [`Self::splat_rows_any`] does.
+    #[inline(always)]
+    fn splat_rows<const N: usize>(
+        &mut self,
+        rows: &RowSplat,
+        wx: &[f32; MAX_TAPS],
+        g: &[f32; TABLE_RES],
+        table: &FilterTable,
+    ) {
+        let w: [f32; N] = std::array::from_fn(|i| wx[i]);
+        let width = self.bounds.width as usize;
+        let mut start = rows.start;
+        for y in rows.py0..=rows.py1 {
+            let vy = rows.v * table.factor(g, y as f32 + 0.5 - rows.pos_y);
+            let row: &mut [Vec4; N] = (&mut self.current[start..start + N])
+                .try_into()
+                .expect("a slice of N pixels");
+            for (sum, w) in row.iter_mut().zip(w) {
+                *sum += vy * w;
+            }
+            start += width;
+        }
+    }
+
+    /// [`Self::splat_rows`] for any number of columns up to [`MAX_TAPS`].
+    #[inline(always)]
+    fn splat_rows_any(
+        &mut self,
+        rows: &RowSplat,
+        taps: usize,
+        wx: &[f32; MAX_TAPS],
+        g: &[f32; TABLE_RES],
+        table: &FilterTable,
+    ) {
+        let width = self.bounds.width as usize;
+        let mut start = rows.start;
+        for y in rows.py0..=rows.py1 {
+            let vy = rows.v * table.factor(g, y as f32 + 0.5 - rows.pos_y);
+            for (sum, &w) in self.current[start..start + taps].iter_mut().zip(&wx[..taps]) {
+                *sum += vy * w;
+            }
+            start += width;
         }
     }
 
@@ -319,6 +369,16 @@ impl TileFilm {
         let weight = weight * self.scale;
         self.current[i] += (value * weight).extend(weight);
     }
+}
+
+/// The rows of one separable splat: where its first row starts in the
+/// tile, its first and last row, the sample's y and its weighted value.
+struct RowSplat {
+    start: usize,
+    py0: i32,
+    py1: i32,
+    pos_y: f32,
+    v: Vec4,
 }
 
 /// `x.ceil() as i32` without the libm call that the baseline x86-64
