@@ -1,7 +1,9 @@
 //! The strategies that join camera vertex `i` of the slots in `req` to a
 //! light subpath, in two batched stages: next-event estimation (s = 1:
 //! the light point drawn by the light's own `sample`, one call per light)
-//! and the connections to every light vertex (s ≥ 2). Each stage queues
+//! and the connections to light vertices (s ≥ 2: every vertex of the
+//! sample's light subpath, or N drawn from the chunk's light vertex cache,
+//! [`super::Connections`]). Each stage queues
 //! its shader evaluations (the BSDF values and the reverse densities the
 //! MIS weights need) and runs them with one call per material, then
 //! traces its shadow rays as one batch.
@@ -10,7 +12,7 @@ use super::mis::{Mis, Side, ratio2, side_sum, weight};
 use super::shading::Op;
 use super::vertex::{Kind, Vertex};
 use super::walk::fit;
-use super::{State, dims};
+use super::{Connections, State, cache_dim, dims};
 use crate::extract::RenderScene;
 use radiant_core::{EmissionKind, EmittedRay, LightSample, Rgb, ShadeContext};
 
@@ -172,66 +174,94 @@ impl State {
         }
     }
 
+    /// The chunk's light vertex cache: every connectable light vertex
+    /// past the light, by slot then index (for `connections: N`).
+    pub(super) fn fill_cache(&mut self) {
+        self.cache.clear();
+        if self.connections == Connections::All {
+            return;
+        }
+        for j in 0..self.ids.len() {
+            for k in 1..self.light.len(j) {
+                if self.light.at(j, k).connectable {
+                    self.cache.push((j as u32, k as u32));
+                }
+            }
+        }
+    }
+
     /// s ≥ 2, t = i + 1: vertex `i` of the slots in `self.req` connected
-    /// to every light vertex k ≥ 1 that `max_depth` allows.
+    /// to light vertices that `max_depth` allows: every one of the slot's
+    /// own light subpath, or `N` drawn from the cache (stratified: draw
+    /// `d` of `N` from the `d`-th `N`-th of the cache, one sampler
+    /// dimension for all), each weighted by the cache's size over `N`
+    /// times the chunk's light subpaths.
     pub(super) fn connect_light(
         &mut self,
         scene: &RenderScene,
         shade: &mut ShadeContext<'_>,
         i: usize,
     ) {
-        let max = self.max;
-        // Candidates (slot in `kept`, light vertex in `call`), four shader
-        // calls each: f at both ends, then both reverse densities.
+        // Candidates (slot in `kept`, light slot in `from`, light vertex
+        // in `call`), four shader calls each: f at both ends, then both
+        // reverse densities.
         self.queue.clear();
         self.kept.clear();
+        self.from.clear();
         self.call.clear();
         self.dirs.clear();
         self.aux.clear();
-        for &j in &self.req {
-            let j = j as usize;
-            let a = self.camera.at(j, i);
-            for k in 1..self.light.len(j) {
-                // Segments: (k + 1) + (i + 1) − 1.
-                if k + i + 1 > max {
-                    break;
+        let scale = match self.connections {
+            Connections::All => {
+                for r in 0..self.req.len() {
+                    let j = self.req[r] as usize;
+                    for k in 1..self.light.len(j) {
+                        // Segments: (k + 1) + (i + 1) − 1.
+                        if k + i + 1 > self.max {
+                            break;
+                        }
+                        self.candidate(scene, i, j, j, k);
+                    }
                 }
-                let b = self.light.at(j, k);
-                if !b.connectable {
-                    continue;
-                }
-                let d = b.it.p - a.it.p;
-                let dist2 = d.length_squared();
-                if dist2 <= 0.0 {
-                    continue;
-                }
-                let w = d / dist2.sqrt();
-                if !a.consistent(w) || !b.consistent(-w) {
-                    continue;
-                }
-                self.queue.push_eval(scene, a, a.wo, w);
-                self.queue.push_eval(scene, b, -w, b.wo);
-                self.queue.push_eval(scene, a, w, a.wo);
-                self.queue.push_eval(scene, b, b.wo, -w);
-                self.kept.push(j as u32);
-                self.call.push(k as u32);
-                self.dirs.push(w);
-                self.aux.push(dist2);
+                1.0
             }
-        }
+            Connections::Drawn(draws) => {
+                let m = self.cache.len();
+                if m == 0 {
+                    return;
+                }
+                self.gather_ids();
+                fit(&mut self.u1, self.req.len());
+                scene
+                    .sampler
+                    .fill_1d(&self.req_ids, cache_dim(self.max, i), &mut self.u1);
+                for r in 0..self.req.len() {
+                    let j = self.req[r] as usize;
+                    for d in 0..draws {
+                        let u = (self.u1[r] + d as f32) / draws as f32;
+                        let (from, k) = self.cache[((u * m as f32) as usize).min(m - 1)];
+                        if k as usize + i < self.max {
+                            self.candidate(scene, i, j, from as usize, k as usize);
+                        }
+                    }
+                }
+                m as f32 / (draws as f32 * self.ids.len() as f32)
+            }
+        };
         self.queue.run(scene, shade, Op::Eval);
         self.shadows.clear();
         self.values.clear();
         self.shadow_of.clear();
         for c in 0..self.kept.len() {
             let (j, k) = (self.kept[c] as usize, self.call[c] as usize);
+            let from = self.from[c] as usize;
             let (w, dist2) = (self.dirs[c], self.aux[c]);
             let e = &self.queue.evals[4 * c..4 * c + 4];
             let (fa, fb) = (e[0], e[1]);
-            let (a, b) = (self.camera.at(j, i), self.light.at(j, k));
+            let (a, b) = (self.camera.at(j, i), self.light.at(from, k));
             let value = a.beta * fa.value * fb.value * b.beta;
             let correction = b.it.ng.dot(w).abs() / b.it.ng.dot(b.wo).abs();
-            let value = value * (correction / dist2);
+            let value = value * (correction * scale / dist2);
             if fa.value == Rgb::ZERO
                 || fb.value == Rgb::ZERO
                 || value == Rgb::ZERO
@@ -241,7 +271,7 @@ impl State {
                 self.shadow_of.push(u32::MAX);
                 continue;
             }
-            let (prev_a, prev_b) = (self.camera.at(j, i - 1), self.light.at(j, k - 1));
+            let (prev_a, prev_b) = (self.camera.at(j, i - 1), self.light.at(from, k - 1));
             let rev_a_prev = prev_a.area_density(a.it.p, e[2].pdf);
             let rev_a = a.area_density(b.it.p, e[3].pdf);
             let rev_b = b.area_density(a.it.p, fa.pdf);
@@ -250,7 +280,7 @@ impl State {
                 _ => prev_b.area_density(b.it.p, fb.pdf),
             };
             let camera_sum = side_sum(self.camera.mis(j, i), Side::Camera, i, rev_a, rev_a_prev);
-            let light_sum = side_sum(self.light.mis(j, k), Side::Light, k, rev_b, rev_b_prev);
+            let light_sum = side_sum(self.light.mis(from, k), Side::Light, k, rev_b, rev_b_prev);
             let w = weight(camera_sum, light_sum, 1.0);
             self.values.push(value * self.strategy(k + 1, i + 1, w));
             self.shadow_of.push(self.shadows.push(a, b) as u32);
@@ -270,5 +300,35 @@ impl State {
             }
             self.radiance[j as usize] += total;
         }
+    }
+}
+
+impl State {
+    /// Queues the connection of camera vertex `i` of slot `j` to light
+    /// vertex `k` of slot `from`'s subpath, unless one of them cannot
+    /// scatter towards the other.
+    fn candidate(&mut self, scene: &RenderScene, i: usize, j: usize, from: usize, k: usize) {
+        let (a, b) = (self.camera.at(j, i), self.light.at(from, k));
+        if !b.connectable {
+            return;
+        }
+        let d = b.it.p - a.it.p;
+        let dist2 = d.length_squared();
+        if dist2 <= 0.0 {
+            return;
+        }
+        let w = d / dist2.sqrt();
+        if !a.consistent(w) || !b.consistent(-w) {
+            return;
+        }
+        self.queue.push_eval(scene, a, a.wo, w);
+        self.queue.push_eval(scene, b, -w, b.wo);
+        self.queue.push_eval(scene, a, w, a.wo);
+        self.queue.push_eval(scene, b, b.wo, -w);
+        self.kept.push(j as u32);
+        self.from.push(from as u32);
+        self.call.push(k as u32);
+        self.dirs.push(w);
+        self.aux.push(dist2);
     }
 }

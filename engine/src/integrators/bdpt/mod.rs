@@ -12,8 +12,10 @@
 //!   towards an environment light;
 //! * s = 1, t ≥ 2: next-event estimation at each camera vertex, the light
 //!   point drawn by the light's own `sample`, as `path` does;
-//! * s ≥ 2, t ≥ 2: each camera vertex connected to each light vertex, with
-//!   a shadow ray;
+//! * s ≥ 2, t ≥ 2: each camera vertex connected to each light vertex of
+//!   its sample's light subpath (`connections: all`), or to N vertices
+//!   drawn from the light vertex cache of the chunk (`connections: N`,
+//!   [`Connections`]), with a shadow ray;
 //! * t = 1: each light vertex connected to the lens
 //!   ([`radiant_core::Importance::sample_wi`]) and splatted where it lands
 //!   on the film, anywhere in the image.
@@ -100,6 +102,14 @@ fn dims(d: u32) -> u32 {
     CAMERA_DIMS + LIGHT_DIMS + d * VERTEX_DIMS
 }
 
+/// The sampler dimension of camera vertex `i`'s light vertex cache draws
+/// under `max` vertices a subpath: past every vertex index's, so that
+/// the other strategies' numbers do not depend on `connections`.
+#[inline]
+fn cache_dim(max: usize, i: usize) -> u32 {
+    dims(max as u32) + i as u32
+}
+
 /// Why `scene` cannot be rendered by `bdpt`, naming the module or feature.
 pub fn check(scene: &RenderScene) -> Result<(), String> {
     if scene.camera.importance().is_none() {
@@ -132,12 +142,44 @@ pub fn check(scene: &RenderScene) -> Result<(), String> {
     Ok(())
 }
 
+/// How the s ≥ 2 strategies join a camera vertex to light vertices.
+///
+/// `All` is Veach's: every light vertex of the sample's own light
+/// subpath. `Drawn(N)` is the light vertex cache of Davidovič et al.
+/// (2014, "Progressive light transport simulation on the GPU"): the
+/// connectable light vertices of all the chunk's light subpaths (`n`
+/// of them, from `m` vertices in all) form a cache, and each camera
+/// vertex connects to `N` of them drawn uniformly (stratified), each
+/// weighted `m / (N n)`. Every light subpath is independent of every
+/// camera subpath, so the expected sum over the draws equals the mean
+/// over the chunk's light subpaths of the full connection sum: the
+/// estimator is unbiased and the MIS weights are unchanged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Connections {
+    /// Every vertex of the sample's own light subpath.
+    All,
+    /// This many vertices drawn from the chunk's light vertex cache.
+    Drawn(u32),
+}
+
+impl Default for Connections {
+    fn default() -> Self {
+        DEFAULT_CONNECTIONS
+    }
+}
+
+/// `connections:` where a scene leaves it out (chosen by measurement,
+/// `engine/benches/BDPT.md`).
+pub const DEFAULT_CONNECTIONS: Connections = Connections::Drawn(1);
+
 /// The `bdpt` integrator (see the module documentation).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Bdpt {
     /// The one strategy (s, t) to render, unweighted (`strategy: [s, t]`),
     /// or `None` for all of them, weighted.
     only: Option<(usize, usize)>,
+    /// How camera vertices connect to light vertices (`connections:`).
+    connections: Connections,
 }
 
 impl Integrator for Bdpt {
@@ -159,6 +201,7 @@ impl TileIntegrator for Bdpt {
         Box::new(Worker {
             state: State {
                 only: self.only,
+                connections: self.connections,
                 ..State::default()
             },
             ..Worker::default()
@@ -166,22 +209,64 @@ impl TileIntegrator for Bdpt {
     }
 }
 
-/// `bdpt`'s own key (`max_depth`, `rr_depth` and `light_selection` are
+/// `bdpt`'s own keys (`max_depth`, `rr_depth` and `light_selection` are
 /// the loader's).
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct BdptParams {
     strategy: Option<[u32; 2]>,
+    connections: Option<ConnectionsParam>,
 }
 
-const DOCS: &[ParamDoc] = &[ParamDoc {
-    name: "strategy",
-    ty: "[s, t]",
-    default: "none (all, weighted)",
-    doc: "Render one strategy alone, unweighted: s light vertices, t ≥ 1 camera vertices — \
-          its image is the contribution of paths of s + t − 1 segments that this strategy \
-          can make (Veach's per-strategy images). For validation.",
-}];
+/// `connections:` as written: `all` or a count.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum ConnectionsParam {
+    Count(u32),
+    Word(String),
+}
+
+const DOCS: &[ParamDoc] = &[
+    ParamDoc {
+        name: "strategy",
+        ty: "[s, t]",
+        default: "none (all, weighted)",
+        doc: "Render one strategy alone, unweighted: s light vertices, t ≥ 1 camera vertices — \
+              its image is the contribution of paths of s + t − 1 segments that this \
+              strategy can make (Veach's per-strategy images). For validation.",
+    },
+    ParamDoc {
+        name: "connections",
+        ty: "all | N ≥ 1",
+        default: "1",
+        doc: "The s ≥ 2 strategies: `all` connects each camera vertex to every vertex of its \
+              own light subpath (Veach); N connects it to N vertices drawn from the light \
+              vertices of all the tile's light subpaths (a light vertex cache), weighted by \
+              the inverse of their probability: unbiased, fewer connections per sample.",
+    },
+];
+
+impl ConnectionsParam {
+    /// The connection rule `self` names.
+    fn parse(self) -> Result<Connections, ParamError> {
+        // Scalars may arrive as text, so a count may be a word.
+        let count = match self {
+            Self::Word(w) if w == "all" => return Ok(Connections::All),
+            Self::Count(n) => n,
+            Self::Word(w) => w.parse().map_err(|_| {
+                ParamError::new(format!(
+                    "`connections: {w}` is neither `all` nor a count of light vertices"
+                ))
+            })?,
+        };
+        if count == 0 {
+            return Err(ParamError::new(
+                "`connections` needs at least 1 light vertex (or `all`)",
+            ));
+        }
+        Ok(Connections::Drawn(count))
+    }
+}
 
 /// Registers `bdpt`.
 pub fn register(registry: &mut Registry) {
@@ -204,7 +289,10 @@ pub fn register(registry: &mut Registry) {
                 Some([s, t]) => Some((s as usize, t as usize)),
                 None => None,
             };
-            Ok(Box::new(Bdpt { only }))
+            let connections = p
+                .connections
+                .map_or(Ok(DEFAULT_CONNECTIONS), ConnectionsParam::parse)?;
+            Ok(Box::new(Bdpt { only, connections }))
         },
     );
 }
@@ -240,6 +328,11 @@ pub struct Worker {
 pub(super) struct State {
     /// The one strategy to render (`strategy: [s, t]`), if any.
     only: Option<(usize, usize)>,
+    /// How camera vertices connect to light vertices.
+    connections: Connections,
+    /// The chunk's light vertex cache (`connections: N`): (slot, index)
+    /// of every connectable light vertex past the light.
+    cache: Vec<(u32, u32)>,
     /// The most vertices a camera subpath may have past the lens.
     max: usize,
     /// The chunk's sample ids, by slot.
@@ -275,6 +368,8 @@ pub(super) struct State {
     pmf: Vec<f32>,
     /// Index of a request's first shader call in `queue`.
     call: Vec<u32>,
+    /// Per connection: the slot of its light vertex's subpath.
+    from: Vec<u32>,
     dirs: Vec<Vec3>,
     values: Vec<Rgb>,
     /// Per request: the solid-angle density of the reverse scattering
@@ -331,6 +426,7 @@ impl TileWorker for Worker {
             state.ids.clear();
             state.ids.extend_from_slice(&self.ids[a..b]);
             state.trace_lights(scene, &mut shade, ctx.splats);
+            state.fill_cache();
             let rays = (&self.origin[a..b], &self.dir[a..b], &self.weight[a..b]);
             state.trace_cameras(scene, &mut shade, rays);
             self.values[a..b].copy_from_slice(&state.radiance[..b - a]);
@@ -502,9 +598,10 @@ mod tests {
     fn dimensions_of_vertices_do_not_overlap() {
         // Each vertex index owns VERTEX_DIMS dimensions after the camera's
         // and the light subpath's start; the last one used is the lens
-        // pair at +11..+12.
+        // pair at +11..+12. The cache draws follow the last index's.
         assert_eq!(dims(0), CAMERA_DIMS + LIGHT_DIMS);
         assert_eq!(dims(1) - dims(0), VERTEX_DIMS);
         const { assert!(11 + 2 <= VERTEX_DIMS) };
+        assert!(cache_dim(8, 1) >= dims(8));
     }
 }
