@@ -133,12 +133,53 @@ struct Entry {
 /// A fixed-capacity stack of entries that lives on the call stack and is
 /// not initialised up front (a ray touches only its first few slots).
 /// Structure-of-arrays, so that the AVX2 traversal writes a node's eight
-/// children at once ([`Stack::push_sorted_avx`]); `WIDTH` slots of slack
+/// children at once ([`Stack::push_avx`]); `WIDTH` slots of slack
 /// above the deepest entry take those writes' unused lanes.
 struct Stack {
     nodes: [MaybeUninit<u32>; STACK_SIZE + WIDTH],
     ts: [MaybeUninit<f32>; STACK_SIZE + WIDTH],
     len: usize,
+}
+
+/// The pushed `lanes` (a bit each) in order of decreasing distance `t`,
+/// then the others: the distances, with the lane number in their three
+/// lowest bits (distances are never negative, so their bits order as
+/// integers; the last bits only break near-ties), go through an
+/// eight-lane bitonic sorting network, lanes not pushed set to −1.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn sorted_order(lanes: u32, t: std::arch::x86_64::__m256) -> std::arch::x86_64::__m256i {
+    use std::arch::x86_64::*;
+    let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    let chosen = _mm256_and_si256(_mm256_set1_epi32(lanes as i32), bits);
+    let skipped = _mm256_cmpeq_epi32(chosen, _mm256_setzero_si256());
+    let ids = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    let keys = _mm256_or_si256(
+        _mm256_andnot_si256(_mm256_set1_epi32(7), _mm256_castps_si256(t)),
+        ids,
+    );
+    let mut keys = _mm256_or_si256(keys, skipped);
+    // Decreasing: sort pairs, merge into fours, then into eight (each
+    // step: partner lanes, then the larger to the lower position).
+    macro_rules! exchange {
+        ($partner:expr, $low_takes_max:literal) => {{
+            let partner = $partner;
+            let (lo, hi) = (
+                _mm256_min_epi32(keys, partner),
+                _mm256_max_epi32(keys, partner),
+            );
+            keys = _mm256_blend_epi32::<$low_takes_max>(lo, hi);
+        }};
+    }
+    exchange!(_mm256_shuffle_epi32::<0xB1>(keys), 0x55);
+    exchange!(_mm256_shuffle_epi32::<0x1B>(keys), 0x33);
+    exchange!(_mm256_shuffle_epi32::<0xB1>(keys), 0x55);
+    let reverse = _mm256_setr_epi32(7, 6, 5, 4, 3, 2, 1, 0);
+    exchange!(_mm256_permutevar8x32_epi32(keys, reverse), 0x0F);
+    exchange!(_mm256_shuffle_epi32::<0x4E>(keys), 0x33);
+    exchange!(_mm256_shuffle_epi32::<0xB1>(keys), 0x55);
+    _mm256_and_si256(keys, _mm256_set1_epi32(7))
 }
 
 /// Per set of lanes (a bit each): those lanes' numbers in increasing
@@ -178,13 +219,7 @@ impl Stack {
         #[cfg(target_arch = "x86_64")]
         if I::AVX2 {
             // SAFETY: `Avx2` traversals run only on CPUs with AVX2 (`Isa`).
-            return unsafe {
-                if sorted {
-                    self.push_sorted_avx(node, lanes, t)
-                } else {
-                    self.push_packed_avx(node, lanes, t)
-                }
-            };
+            return unsafe { self.push_avx(node, lanes, t, sorted) };
         }
         self.push_lanes(node, lanes, t, sorted);
     }
@@ -216,17 +251,15 @@ impl Stack {
         }
     }
 
-    /// [`Self::push`] sorted without branches: the lanes' distances, with
-    /// the lane number in their three lowest bits (distances are never
-    /// negative, so their bits order as integers; the last bits only
-    /// break near-ties), go through an eight-lane sorting network in
-    /// decreasing order, lanes not pushed last; then all eight children
-    /// and distances are written in that order and the stack grows by the
-    /// number pushed.
+    /// [`Self::push`] without branches: the pushed lanes' children and
+    /// distances are permuted to the front — sorted by distance
+    /// ([`sorted_order`]) or in lane order, the last lane popped first
+    /// ([`PACK`]) — and all eight lanes are written from the top of the
+    /// stack, which grows by the number pushed.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[inline]
-    fn push_sorted_avx(&mut self, node: &Node, lanes: u32, t: &[f32; WIDTH]) {
+    fn push_avx(&mut self, node: &Node, lanes: u32, t: &[f32; WIDTH], sorted: bool) {
         use std::arch::x86_64::*;
         // SAFETY: `t` and `node.child` hold eight 32-bit values each.
         let (t, child) = unsafe {
@@ -235,73 +268,11 @@ impl Stack {
                 _mm256_loadu_si256(node.child.as_ptr().cast()),
             )
         };
-        let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
-        let chosen = _mm256_and_si256(_mm256_set1_epi32(lanes as i32), bits);
-        let skipped = _mm256_cmpeq_epi32(chosen, _mm256_setzero_si256());
-        let ids = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-        let keys = _mm256_or_si256(
-            _mm256_andnot_si256(_mm256_set1_epi32(7), _mm256_castps_si256(t)),
-            ids,
-        );
-        // Lanes not pushed become −1, below every distance.
-        let mut keys = _mm256_or_si256(keys, skipped);
-        // Bitonic network, decreasing: sort pairs, merge into fours, then
-        // into eight (each step: partner lanes, then the larger to the
-        // lower position).
-        macro_rules! exchange {
-            ($partner:expr, $low_takes_max:literal) => {{
-                let partner = $partner;
-                let (lo, hi) = (
-                    _mm256_min_epi32(keys, partner),
-                    _mm256_max_epi32(keys, partner),
-                );
-                keys = _mm256_blend_epi32::<$low_takes_max>(lo, hi);
-            }};
-        }
-        exchange!(_mm256_shuffle_epi32::<0xB1>(keys), 0x55);
-        exchange!(_mm256_shuffle_epi32::<0x1B>(keys), 0x33);
-        exchange!(_mm256_shuffle_epi32::<0xB1>(keys), 0x55);
-        let reverse = _mm256_setr_epi32(7, 6, 5, 4, 3, 2, 1, 0);
-        exchange!(_mm256_permutevar8x32_epi32(keys, reverse), 0x0F);
-        exchange!(_mm256_shuffle_epi32::<0x4E>(keys), 0x33);
-        exchange!(_mm256_shuffle_epi32::<0xB1>(keys), 0x55);
-        let order = _mm256_and_si256(keys, _mm256_set1_epi32(7));
-        self.write_lanes(child, t, order, lanes);
-    }
-
-    /// [`Self::push`] in lane order (the last lane is popped first),
-    /// without branches: the pushed lanes are packed to the front by a
-    /// permutation from [`PACK`].
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    #[inline]
-    fn push_packed_avx(&mut self, node: &Node, lanes: u32, t: &[f32; WIDTH]) {
-        use std::arch::x86_64::*;
-        // SAFETY: `t` and `node.child` hold eight 32-bit values each.
-        let (t, child) = unsafe {
-            (
-                _mm256_loadu_ps(t.as_ptr()),
-                _mm256_loadu_si256(node.child.as_ptr().cast()),
-            )
+        let order = if sorted {
+            sorted_order(lanes, t)
+        } else {
+            _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(PACK[lanes as usize & 0xff] as i64))
         };
-        let order = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(PACK[lanes as usize & 0xff] as i64));
-        self.write_lanes(child, t, order, lanes);
-    }
-
-    /// Writes children `child` and distances `t`, permuted by `order`, to
-    /// the eight slots from the top of the stack, which grows by the
-    /// number of bits in `lanes`.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    #[inline]
-    fn write_lanes(
-        &mut self,
-        child: std::arch::x86_64::__m256i,
-        t: std::arch::x86_64::__m256,
-        order: std::arch::x86_64::__m256i,
-        lanes: u32,
-    ) {
-        use std::arch::x86_64::*;
         let nodes = _mm256_permutevar8x32_epi32(child, order);
         let ts = _mm256_permutevar8x32_ps(t, order);
         // Panics rather than overflowing; `MAX_DEPTH` rules that out.
