@@ -367,9 +367,28 @@ pub struct RayBoxes {
     /// direction is positive), and of those it meets last. Offsets rather
     /// than side indices, so that a node test loads them without
     /// recomputing addresses.
-    near: [usize; 3],
-    far: [usize; 3],
+    near: [u32; 3],
+    far: [u32; 3],
 }
+
+/// [`RayBoxes::near`] and [`RayBoxes::far`] by the signs of the
+/// direction's components (bit `axis` set where it is negative): a table,
+/// so that each ray entering a hierarchy copies them rather than computes.
+const OFFSETS: [([u32; 3], [u32; 3]); 8] = {
+    let mut table = [([0; 3], [0; 3]); 8];
+    let mut signs = 0;
+    while signs < 8 {
+        let mut axis = 0;
+        while axis < 3 {
+            let side = (signs >> axis) & 1;
+            table[signs].0[axis] = (side * SIDE_BYTES + axis * AXIS_BYTES) as u32;
+            table[signs].1[axis] = ((side ^ 1) * SIDE_BYTES + axis * AXIS_BYTES) as u32;
+            axis += 1;
+        }
+        signs += 1;
+    }
+    table
+};
 
 /// Bytes between `Node::bounds[0]` and `Node::bounds[1]`, and between
 /// consecutive axes.
@@ -390,27 +409,26 @@ impl RayBoxes {
     /// per component), where the caller has it already.
     #[inline(always)]
     pub fn from_inverse(origin: Vec3, inv_dir: Vec3A) -> Self {
-        let negative = inv_dir.cmplt(Vec3A::ZERO).bitmask() as usize;
-        let side = |axis: usize| (negative >> axis) & 1;
+        let (near, far) = OFFSETS[inv_dir.cmplt(Vec3A::ZERO).bitmask() as usize & 7];
         Self {
             origin: origin.to_array(),
             inv_dir: inv_dir.to_array(),
-            near: std::array::from_fn(|axis| side(axis) * SIDE_BYTES + axis * AXIS_BYTES),
-            far: std::array::from_fn(|axis| (side(axis) ^ 1) * SIDE_BYTES + axis * AXIS_BYTES),
+            near,
+            far,
         }
     }
 
     /// Four lanes of `node`'s bounds at byte `offset` (one of
     /// [`RayBoxes::near`] or [`RayBoxes::far`]) plus group `g`.
     #[inline(always)]
-    fn lanes(node: &Node, offset: usize, g: usize) -> Vec4 {
+    fn lanes(node: &Node, offset: u32, g: usize) -> Vec4 {
         // SAFETY: `offset` is side · SIDE_BYTES + axis · AXIS_BYTES with
         // side < 2 and axis < 3, so with g < GROUPS it addresses a whole
         // `Vec4` of `node.bounds`.
         unsafe {
             let bytes = (node as *const Node).cast::<u8>();
             bytes
-                .add(offset + g * std::mem::size_of::<Vec4>())
+                .add(offset as usize + g * std::mem::size_of::<Vec4>())
                 .cast::<Vec4>()
                 .read()
         }
@@ -444,7 +462,7 @@ impl RayBoxes {
             // SAFETY: both offsets address a group pair of `node.bounds`
             // (`RayBoxes::lanes`): eight contiguous f32 in a 64-byte
             // aligned node, at a multiple of 32 bytes (an aligned load).
-            let bounds = |offset: usize| unsafe { _mm256_load_ps(bytes.add(offset).cast()) };
+            let bounds = |offset: u32| unsafe { _mm256_load_ps(bytes.add(offset as usize).cast()) };
             let lo = _mm256_mul_ps(_mm256_sub_ps(bounds(self.near[axis]), origin), inv_dir);
             let hi = _mm256_mul_ps(_mm256_sub_ps(bounds(self.far[axis]), origin), inv_dir);
             // MAXPS/MINPS keep the second operand where the first is NaN,
