@@ -10,7 +10,11 @@
 //!
 //! Traversal intersects a node's leaves as soon as the node is visited and
 //! keeps only inner nodes on its stack, so each step is one box test and no
-//! branch has to guess whether the next entry is a leaf.
+//! branch has to guess whether the next entry is a leaf. With AVX2 the hit
+//! children go onto the stack without branches (their number and order
+//! are what a CPU predicts worst): closest-hit rays push them sorted by a
+//! bitonic network over the eight lanes' distances, shadow rays packed in
+//! lane order by a permutation table.
 //!
 //! Box tests follow Ize's "Robust BVH Ray Traversal" (2013): the far
 //! distance is enlarged by the worst-case rounding error of the slab test,
@@ -61,6 +65,8 @@ struct Node {
 const LEAF: u32 = 1 << 31;
 
 const _: () = assert!(std::mem::size_of::<Node>() == 256);
+// `RayBoxes` addresses the bounds by byte offsets from the node's start.
+const _: () = assert!(std::mem::offset_of!(Node, bounds) == 0);
 
 impl Node {
     const EMPTY: Node = Node {
@@ -130,16 +136,81 @@ struct Entry {
 
 /// A fixed-capacity stack of entries that lives on the call stack and is
 /// not initialised up front (a ray touches only its first few slots).
+/// Structure-of-arrays, so that the AVX2 traversal writes a node's eight
+/// children at once ([`Stack::push_avx`]); `WIDTH` slots of slack
+/// above the deepest entry take those writes' unused lanes.
 struct Stack {
-    items: [MaybeUninit<Entry>; STACK_SIZE],
+    nodes: [MaybeUninit<u32>; STACK_SIZE + WIDTH],
+    ts: [MaybeUninit<f32>; STACK_SIZE + WIDTH],
     len: usize,
 }
+
+/// The pushed `lanes` (a bit each) in order of decreasing distance `t`,
+/// then the others: the distances, with the lane number in their three
+/// lowest bits (distances are never negative, so their bits order as
+/// integers; the last bits only break near-ties), go through an
+/// eight-lane bitonic sorting network, lanes not pushed set to −1.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn sorted_order(lanes: u32, t: std::arch::x86_64::__m256) -> std::arch::x86_64::__m256i {
+    use std::arch::x86_64::*;
+    let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    let chosen = _mm256_and_si256(_mm256_set1_epi32(lanes as i32), bits);
+    let skipped = _mm256_cmpeq_epi32(chosen, _mm256_setzero_si256());
+    let ids = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    let keys = _mm256_or_si256(
+        _mm256_andnot_si256(_mm256_set1_epi32(7), _mm256_castps_si256(t)),
+        ids,
+    );
+    let mut keys = _mm256_or_si256(keys, skipped);
+    // Decreasing: sort pairs, merge into fours, then into eight (each
+    // step: partner lanes, then the larger to the lower position).
+    macro_rules! exchange {
+        ($partner:expr, $low_takes_max:literal) => {{
+            let partner = $partner;
+            let (lo, hi) = (
+                _mm256_min_epi32(keys, partner),
+                _mm256_max_epi32(keys, partner),
+            );
+            keys = _mm256_blend_epi32::<$low_takes_max>(lo, hi);
+        }};
+    }
+    exchange!(_mm256_shuffle_epi32::<0xB1>(keys), 0x55);
+    exchange!(_mm256_shuffle_epi32::<0x1B>(keys), 0x33);
+    exchange!(_mm256_shuffle_epi32::<0xB1>(keys), 0x55);
+    let reverse = _mm256_setr_epi32(7, 6, 5, 4, 3, 2, 1, 0);
+    exchange!(_mm256_permutevar8x32_epi32(keys, reverse), 0x0F);
+    exchange!(_mm256_shuffle_epi32::<0x4E>(keys), 0x33);
+    exchange!(_mm256_shuffle_epi32::<0xB1>(keys), 0x55);
+    _mm256_and_si256(keys, _mm256_set1_epi32(7))
+}
+
+/// Per set of lanes (a bit each): those lanes' numbers in increasing
+/// order, one per byte from the lowest, then zeros.
+const PACK: [u64; 256] = {
+    let mut table = [0u64; 256];
+    let mut lanes = 0;
+    while lanes < 256 {
+        let (mut lane, mut at) = (0, 0);
+        while lane < WIDTH {
+            if lanes & (1 << lane) != 0 {
+                table[lanes] |= (lane as u64) << (8 * at);
+                at += 1;
+            }
+            lane += 1;
+        }
+        lanes += 1;
+    }
+    table
+};
 
 impl Stack {
     #[inline(always)]
     fn new() -> Self {
         Self {
-            items: [const { MaybeUninit::uninit() }; STACK_SIZE],
+            nodes: [const { MaybeUninit::uninit() }; STACK_SIZE + WIDTH],
+            ts: [const { MaybeUninit::uninit() }; STACK_SIZE + WIDTH],
             len: 0,
         }
     }
@@ -147,6 +218,17 @@ impl Stack {
     /// Pushes the children of `node` in `lanes` (a bit per lane), with
     /// their entry distances `t`; with `sorted`, so that the entries pushed
     /// are in order of decreasing distance (the nearest is popped first).
+    #[inline(always)]
+    fn push<I: Isa>(&mut self, node: &Node, lanes: u32, t: &[f32; WIDTH], sorted: bool) {
+        #[cfg(target_arch = "x86_64")]
+        if I::AVX2 {
+            // SAFETY: `Avx2` traversals run only on CPUs with AVX2 (`Isa`).
+            return unsafe { self.push_avx(node, lanes, t, sorted) };
+        }
+        self.push_lanes(node, lanes, t, sorted);
+    }
+
+    /// [`Self::push`] one lane at a time.
     #[inline(always)]
     fn push_lanes(&mut self, node: &Node, mut lanes: u32, t: &[f32; WIDTH], sorted: bool) {
         let base = self.len;
@@ -159,17 +241,72 @@ impl Stack {
             };
             let mut i = self.len;
             // Panics rather than overflowing; `MAX_DEPTH` rules that out.
-            self.items[i].write(e);
+            self.write(i, e);
             self.len += 1;
             while sorted && i > base {
-                // SAFETY: slots below `len` have been written.
-                let below = unsafe { self.items[i - 1].assume_init() };
+                let below = self.read(i - 1);
                 if below.t >= e.t {
                     break;
                 }
-                self.items[i].write(below);
-                self.items[i - 1].write(e);
+                self.write(i, below);
+                self.write(i - 1, e);
                 i -= 1;
+            }
+        }
+    }
+
+    /// [`Self::push`] without branches: the pushed lanes' children and
+    /// distances are permuted to the front — sorted by distance
+    /// ([`sorted_order`]) or in lane order, the last lane popped first
+    /// ([`PACK`]) — and all eight lanes are written from the top of the
+    /// stack, which grows by the number pushed.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn push_avx(&mut self, node: &Node, lanes: u32, t: &[f32; WIDTH], sorted: bool) {
+        use std::arch::x86_64::*;
+        // SAFETY: `t` and `node.child` hold eight 32-bit values each.
+        let (t, child) = unsafe {
+            (
+                _mm256_loadu_ps(t.as_ptr()),
+                _mm256_loadu_si256(node.child.as_ptr().cast()),
+            )
+        };
+        let order = if sorted {
+            sorted_order(lanes, t)
+        } else {
+            _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(PACK[lanes as usize & 0xff] as i64))
+        };
+        let nodes = _mm256_permutevar8x32_epi32(child, order);
+        let ts = _mm256_permutevar8x32_ps(t, order);
+        // Panics rather than overflowing; `MAX_DEPTH` rules that out.
+        let (nodes_at, ts_at) = (
+            self.nodes[self.len..self.len + WIDTH].as_mut_ptr(),
+            self.ts[self.len..self.len + WIDTH].as_mut_ptr(),
+        );
+        // SAFETY: both point at eight slots of the stack (checked above).
+        unsafe {
+            _mm256_storeu_si256(nodes_at.cast(), nodes);
+            _mm256_storeu_ps(ts_at.cast(), ts);
+        }
+        self.len += lanes.count_ones() as usize;
+    }
+
+    #[inline(always)]
+    fn write(&mut self, i: usize, e: Entry) {
+        self.nodes[i].write(e.node);
+        self.ts[i].write(e.t);
+    }
+
+    /// Entry `i`, which must have been written.
+    #[inline(always)]
+    fn read(&self, i: usize) -> Entry {
+        // SAFETY: callers read only slots below `len`, which have been
+        // written.
+        unsafe {
+            Entry {
+                node: self.nodes[i].assume_init(),
+                t: self.ts[i].assume_init(),
             }
         }
     }
@@ -177,8 +314,7 @@ impl Stack {
     #[inline(always)]
     fn pop(&mut self) -> Option<Entry> {
         self.len = self.len.checked_sub(1)?;
-        // SAFETY: slots below `len` have been written.
-        Some(unsafe { self.items[self.len].assume_init() })
+        Some(self.read(self.len))
     }
 }
 
@@ -230,9 +366,38 @@ impl Avx2 {
 pub struct RayBoxes {
     origin: [f32; 3],
     inv_dir: [f32; 3],
-    /// Per axis: which of `Node::bounds` the ray meets first (0: minimum).
-    near: [usize; 3],
+    /// Per axis: the byte offset in a [`Node`] of the first four lanes of
+    /// the bounds the ray meets first along that axis (the minima where the
+    /// direction is positive), and of those it meets last. Offsets rather
+    /// than side indices, so that a node test loads them without
+    /// recomputing addresses.
+    near: [u32; 3],
+    far: [u32; 3],
 }
+
+/// [`RayBoxes::near`] and [`RayBoxes::far`] by the signs of the
+/// direction's components (bit `axis` set where it is negative): a table,
+/// so that each ray entering a hierarchy copies them rather than computes.
+const OFFSETS: [([u32; 3], [u32; 3]); 8] = {
+    let mut table = [([0; 3], [0; 3]); 8];
+    let mut signs = 0;
+    while signs < 8 {
+        let mut axis = 0;
+        while axis < 3 {
+            let side = (signs >> axis) & 1;
+            table[signs].0[axis] = (side * SIDE_BYTES + axis * AXIS_BYTES) as u32;
+            table[signs].1[axis] = ((side ^ 1) * SIDE_BYTES + axis * AXIS_BYTES) as u32;
+            axis += 1;
+        }
+        signs += 1;
+    }
+    table
+};
+
+/// Bytes between `Node::bounds[0]` and `Node::bounds[1]`, and between
+/// consecutive axes.
+const SIDE_BYTES: usize = 3 * AXIS_BYTES;
+const AXIS_BYTES: usize = GROUPS * std::mem::size_of::<Vec4>();
 
 impl RayBoxes {
     /// Prepares the ray `origin + t·dir` (both finite).
@@ -241,12 +406,35 @@ impl RayBoxes {
         // A zero component gives an infinite inverse: the slab test then
         // yields ±∞, or 0·∞ = NaN for a face through the origin, which
         // `max_of`/`min_of` drop (the ray lies in the face: no constraint).
-        let inv_dir = Vec3A::ONE / Vec3A::from(dir);
-        let negative = inv_dir.cmplt(Vec3A::ZERO).bitmask() as usize;
+        Self::from_inverse(origin, Vec3A::ONE / Vec3A::from(dir))
+    }
+
+    /// [`RayBoxes::new`] from the direction's inverse `inv_dir` (`1/dir`
+    /// per component), where the caller has it already.
+    #[inline(always)]
+    pub fn from_inverse(origin: Vec3, inv_dir: Vec3A) -> Self {
+        let (near, far) = OFFSETS[inv_dir.cmplt(Vec3A::ZERO).bitmask() as usize & 7];
         Self {
             origin: origin.to_array(),
             inv_dir: inv_dir.to_array(),
-            near: [negative & 1, (negative >> 1) & 1, negative >> 2],
+            near,
+            far,
+        }
+    }
+
+    /// Four lanes of `node`'s bounds at byte `offset` (one of
+    /// [`RayBoxes::near`] or [`RayBoxes::far`]) plus group `g`.
+    #[inline(always)]
+    fn lanes(node: &Node, offset: u32, g: usize) -> Vec4 {
+        // SAFETY: `offset` is side · SIDE_BYTES + axis · AXIS_BYTES with
+        // side < 2 and axis < 3, so with g < GROUPS it addresses a whole
+        // `Vec4` of `node.bounds`.
+        unsafe {
+            let bytes = (node as *const Node).cast::<u8>();
+            bytes
+                .add(offset as usize + g * std::mem::size_of::<Vec4>())
+                .cast::<Vec4>()
+                .read()
         }
     }
 
@@ -271,17 +459,16 @@ impl RayBoxes {
         use std::arch::x86_64::*;
         let mut t_near = _mm256_setzero_ps();
         let mut t_far = _mm256_set1_ps(tmax);
+        let bytes = (node as *const Node).cast::<u8>();
         for axis in 0..3 {
-            let near = self.near[axis] & 1;
             let origin = _mm256_set1_ps(self.origin[axis]);
             let inv_dir = _mm256_set1_ps(self.inv_dir[axis]);
-            let bounds = |side: usize| {
-                // SAFETY: a group pair is eight contiguous f32 in a 64-byte
-                // aligned node, at a multiple of 32 bytes (an aligned load).
-                unsafe { _mm256_load_ps(node.bounds[side][axis].as_ptr().cast()) }
-            };
-            let lo = _mm256_mul_ps(_mm256_sub_ps(bounds(near), origin), inv_dir);
-            let hi = _mm256_mul_ps(_mm256_sub_ps(bounds(near ^ 1), origin), inv_dir);
+            // SAFETY: both offsets address a group pair of `node.bounds`
+            // (`RayBoxes::lanes`): eight contiguous f32 in a 64-byte
+            // aligned node, at a multiple of 32 bytes (an aligned load).
+            let bounds = |offset: u32| unsafe { _mm256_load_ps(bytes.add(offset as usize).cast()) };
+            let lo = _mm256_mul_ps(_mm256_sub_ps(bounds(self.near[axis]), origin), inv_dir);
+            let hi = _mm256_mul_ps(_mm256_sub_ps(bounds(self.far[axis]), origin), inv_dir);
             // MAXPS/MINPS keep the second operand where the first is NaN,
             // as `max_of` and `min_of` do.
             t_near = _mm256_max_ps(lo, t_near);
@@ -304,13 +491,12 @@ impl RayBoxes {
             let mut t_near = Vec4::ZERO;
             let mut t_far = Vec4::splat(tmax);
             for axis in 0..3 {
-                let near = self.near[axis] & 1;
                 let (origin, inv_dir) = (
                     Vec4::splat(self.origin[axis]),
                     Vec4::splat(self.inv_dir[axis]),
                 );
-                let lo = (node.bounds[near][axis][g] - origin) * inv_dir;
-                let hi = (node.bounds[near ^ 1][axis][g] - origin) * inv_dir;
+                let lo = (Self::lanes(node, self.near[axis], g) - origin) * inv_dir;
+                let hi = (Self::lanes(node, self.far[axis], g) - origin) * inv_dir;
                 t_near = max_of(lo, t_near);
                 t_far = min_of(hi, t_far);
             }
@@ -588,7 +774,7 @@ impl WideBvh {
                     continue;
                 }
             } else {
-                stack.push_lanes(node, inner, &t_near, true);
+                stack.push::<I>(node, inner, &t_near, true);
             }
             // Next: the nearest pending node that is not beyond the hit.
             loop {
@@ -622,7 +808,7 @@ impl WideBvh {
                     return true;
                 }
             }
-            stack.push_lanes(node, mask & !leaf_lanes, &t_near, false);
+            stack.push::<I>(node, mask & !leaf_lanes, &t_near, false);
             match stack.pop() {
                 Some(e) => current = e.node as usize,
                 None => return false,
@@ -756,5 +942,78 @@ fn push_primitives(bvh2: &Bvh2, index: usize, prims: &mut Vec<u32>) {
         } else {
             pending.extend([first + 1, first]);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::tests::lcg;
+
+    /// Pushes random lanes of a node with random distances (ties and
+    /// zeros included) on a stack that already holds an entry, and checks
+    /// what pops: exactly the pushed children, nearest first where sorted,
+    /// last lane first otherwise, then the older entry.
+    fn check_pushes<I: Isa>() {
+        let mut node = Node::EMPTY;
+        for (lane, child) in node.child.iter_mut().enumerate() {
+            *child = 100 + lane as u32;
+        }
+        let mut s = 3;
+        for round in 0..20_000 {
+            let lanes = (lcg(&mut s) * 256.0) as u32;
+            let t: [f32; WIDTH] = std::array::from_fn(|_| match (lcg(&mut s) * 4.0) as u32 {
+                0 => 0.0,
+                1 => 0.5,
+                _ => lcg(&mut s) * 10.0,
+            });
+            let sorted = round % 2 == 0;
+            let mut stack = Stack::new();
+            stack.write(0, Entry { node: 7, t: -1.0 });
+            stack.len = 1;
+            stack.push::<I>(&node, lanes, &t, sorted);
+            let mut popped = Vec::new();
+            while let Some(e) = stack.pop() {
+                popped.push(e);
+            }
+            let old = popped.pop().expect("the older entry");
+            assert_eq!(old.node, 7);
+            let got: Vec<usize> = popped.iter().map(|e| (e.node - 100) as usize).collect();
+            for (e, &lane) in popped.iter().zip(&got) {
+                assert_eq!(e.t.to_bits(), t[lane].to_bits());
+            }
+            let mut want: Vec<usize> = (0..WIDTH).filter(|l| lanes & (1 << l) != 0).collect();
+            if sorted {
+                // In order of distance, up to the last three bits (the
+                // AVX2 sort keys hold the lane there).
+                let key = |e: &Entry| e.t.to_bits() & !7;
+                assert!(
+                    popped.windows(2).all(|w| key(&w[0]) <= key(&w[1])),
+                    "{popped:?}"
+                );
+                let mut got = got.clone();
+                got.sort_unstable();
+                assert_eq!(got, want, "lanes {lanes:08b}");
+            } else {
+                want.reverse();
+                assert_eq!(got, want, "lanes {lanes:08b}");
+            }
+        }
+    }
+
+    #[test]
+    fn stacks_pop_exactly_the_pushed_children_in_order() {
+        check_pushes::<Baseline>();
+        #[cfg(target_arch = "x86_64")]
+        if Avx2::detected() {
+            // SAFETY: the CPU supports AVX2.
+            unsafe { check_pushes_avx2() };
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn check_pushes_avx2() {
+        check_pushes::<Avx2>();
     }
 }
