@@ -341,7 +341,10 @@ impl TileFilm {
         let mut start = rows.start;
         for y in rows.py0..=rows.py1 {
             let vy = rows.v * table.factor(g, y as f32 + 0.5 - rows.pos_y);
-            for (sum, &w) in self.current[start..start + taps].iter_mut().zip(&wx[..taps]) {
+            for (sum, &w) in self.current[start..start + taps]
+                .iter_mut()
+                .zip(&wx[..taps])
+            {
                 *sum += vy * w;
             }
             start += width;
