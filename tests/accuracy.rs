@@ -407,8 +407,9 @@ fn integrator_and_adaptive_axes_are_measured_by_whole_renders() {
     let integrators = radiant::builtin_registry()
         .names::<dyn radiant::integrators::Integrator>()
         .len();
-    // The baseline, every integrator but `path`, and adaptive sampling.
-    assert_eq!(labels.len(), 1 + (integrators - 1) + 1, "{labels:?}");
+    // The baseline, every integrator but `path`, and adaptive sampling
+    // toward each error goal.
+    assert_eq!(labels.len(), 1 + (integrators - 1) + 2, "{labels:?}");
     for curve in &report.curves {
         let spp: Vec<u32> = curve.points.iter().map(|p| p.spp).collect();
         assert_eq!(spp, [2, 4, 8, 16, 32], "{}", curve.setting.label());
@@ -418,13 +419,16 @@ fn integrator_and_adaptive_axes_are_measured_by_whole_renders() {
             curve.setting.label()
         );
     }
-    // Adaptive sampling is unbiased, and its error falls with its most spp.
-    let adaptive = report
-        .curves
-        .iter()
-        .find(|c| c.setting.label() == "adaptive=on")
-        .unwrap();
-    assert!(!adaptive.is_biased(), "{:?}", adaptive.last());
-    let (first, last) = (&adaptive.points[0], adaptive.last().unwrap());
-    assert!(last.metrics.rmse < 0.5 * first.metrics.rmse);
+    // Adaptive sampling is unbiased, and its error falls with its spp
+    // (the most a pixel takes, or the average under `mse`).
+    for label in ["adaptive=relative", "adaptive=mse"] {
+        let adaptive = report
+            .curves
+            .iter()
+            .find(|c| c.setting.label() == label)
+            .unwrap();
+        assert!(!adaptive.is_biased(), "{label}: {:?}", adaptive.last());
+        let (first, last) = (&adaptive.points[0], adaptive.last().unwrap());
+        assert!(last.metrics.rmse < 0.5 * first.metrics.rmse, "{label}");
+    }
 }

@@ -134,6 +134,79 @@ fn the_adaptive_image_is_unbiased() {
     assert!(ea < 0.03 * f && ef < 0.03 * f, "{ea} {ef} of {f}");
 }
 
+/// Adaptive sampling toward the least MSE: 64 samples a pixel on average.
+const ADAPTIVE_MSE: &str = "{type: independent, spp: 64, adaptive: {error: mse}}";
+
+#[test]
+fn the_mse_goal_spends_the_budget_on_the_noisy_pixels() {
+    let (image, counts) = render(ADAPTIVE_MSE, 1);
+    let at = |x: u32, y: u32| counts[(y * 32 + x) as usize];
+    let mean = counts.iter().map(|&c| f64::from(c)).sum::<f64>() / counts.len() as f64;
+    // The budget, within the rounding of the counts to four per octave.
+    assert!((mean - 64.0).abs() < 8.0, "mean count {mean}");
+    let region = |inside: fn(u32, u32) -> bool| -> Vec<u32> {
+        (0..16)
+            .flat_map(|y| (0..32).map(move |x| (x, y)))
+            .filter(|&(x, y)| inside(x, y))
+            .map(|(x, y)| at(x, y))
+            .collect()
+    };
+    // Flat pixels (σ = 0, among equal neighbours) take the floor, 64 / 4.
+    assert!(region(flat).iter().all(|&c| c == 16), "{:?}", region(flat));
+    let noisy = region(noisy);
+    let noisy_mean = noisy.iter().map(|&c| f64::from(c)).sum::<f64>() / noisy.len() as f64;
+    assert!(
+        noisy_mean > 96.0,
+        "noisy pixels took {noisy_mean} on average"
+    );
+    assert!((region_mean(&image, flat) - 3.0).abs() < 1e-5);
+}
+
+#[test]
+fn the_mse_goal_is_unbiased_and_lowers_the_error_at_equal_budget() {
+    // Against a fixed 4096-spp render: the noisy region's mean within its
+    // standard errors, and the whole image's MSE (four seeds each) below
+    // fixed spp's at the same average spp. (Spending the budget evenly
+    // instead, the counts of fixed spp, gives the same MSE as fixed and
+    // fails; the flat half's budget is what moves.)
+    let reference = render("{type: independent, spp: 4096}", 999).0;
+    let mse = |image: &Image| -> f64 {
+        let sq: f64 = image
+            .pixels
+            .iter()
+            .zip(&reference.pixels)
+            .map(|(a, b)| f64::from((*a - *b).element_sum()).powi(2))
+            .sum();
+        sq / image.pixels.len() as f64
+    };
+    let seeds = 1..=6u64;
+    let (mut adaptive, mut fixed) = (Vec::new(), Vec::new());
+    let (mut adaptive_mse, mut fixed_mse) = (0.0, 0.0);
+    for s in seeds {
+        let a = render(ADAPTIVE_MSE, s).0;
+        let f = render("{type: independent, spp: 64}", 100 + s).0;
+        adaptive.push(region_mean(&a, noisy));
+        fixed.push(region_mean(&f, noisy));
+        adaptive_mse += mse(&a);
+        fixed_mse += mse(&f);
+    }
+    let (a, ea) = mean_and_error(&adaptive);
+    let r = region_mean(&reference, noisy);
+    assert!(
+        (a - r).abs() < 4.0 * ea + 0.005 * r,
+        "adaptive {a:.5} ± {ea:.5} against the reference {r:.5}"
+    );
+    let (f, ef) = mean_and_error(&fixed);
+    assert!(
+        (f - r).abs() < 4.0 * ef + 0.005 * r,
+        "fixed {f:.5} ± {ef:.5} against {r:.5}"
+    );
+    assert!(
+        adaptive_mse < 0.7 * fixed_mse,
+        "MSE: adaptive {adaptive_mse:.4e}, fixed {fixed_mse:.4e}"
+    );
+}
+
 #[test]
 fn bad_adaptive_keys_are_located_errors() {
     for (sampler, needle) in [
@@ -154,6 +227,11 @@ fn bad_adaptive_keys_are_located_errors() {
             "min_spp",
         ),
         ("{type: independent, adaptive: {thresold: 0.1}}", "thresold"),
+        (
+            "{type: independent, adaptive: {error: mse, threshold: 0.1}}",
+            "relative rule",
+        ),
+        ("{type: independent, adaptive: {error: rms}}", "mse"),
     ] {
         let text = scene(sampler);
         let err = radiant::scene::from_str(&text, Path::new("adaptive.yaml"), Path::new("."))
@@ -222,7 +300,16 @@ fn adaptive_renders_in_passes_and_resumed_equal_one_render() {
     // pixel's count, weighted by 1 / the count, and the counts decided by
     // the first pass are kept in the film; a resumed render (a film of the
     // sums alone, as the resume file holds) decides again, the same.
-    let text = scene(ADAPTIVE).replace(
+    for sampler in [ADAPTIVE, ADAPTIVE_MSE] {
+        passes_and_resume_equal_one_render(sampler);
+    }
+}
+
+/// Renders `sampler`'s Gaussian-filtered scene whole, then in passes cut at
+/// 4/256, 40/256, 100/256 and 180/256 of its spp, with a resume after the
+/// third, and checks the images are the same.
+fn passes_and_resume_equal_one_render(sampler: &str) {
+    let text = scene(sampler).replace(
         "filter: {type: box}",
         "filter: {type: gaussian, stddev: 0.5}",
     );
@@ -236,17 +323,22 @@ fn adaptive_renders_in_passes_and_resumed_equal_one_render() {
     let (one, counts) = (one.image, counts.expect("a tile integrator counts"));
     let mut film = Film::new(r.settings.width, r.settings.height);
     let mut samples = 0;
-    for pass in [0..4, 4..40, 40..100] {
+    let spp = r.settings.spp;
+    let cut = |k: u32| k * spp / 256;
+    for pass in [0..cut(4), cut(4)..cut(40), cut(40)..cut(100)] {
         samples += render_samples(&r, &mut film, pass, &Progress::none()).samples;
     }
-    // "Interrupted" at 100 of 256 spp: the state file keeps the sums only.
+    // "Interrupted" at 100/256 of the spp: the state file keeps the sums only.
     let mut resumed = film.clone();
     resumed.adaptive_counts = None;
-    for pass in [100..180, 180..256] {
+    for pass in [cut(100)..cut(180), cut(180)..spp] {
         samples += render_samples(&r, &mut resumed, pass, &Progress::none()).samples;
     }
     let image = resumed.try_develop().expect("fits");
-    assert!(image == one, "passes and resume differ from one render");
+    assert!(
+        image == one,
+        "{sampler}: passes and resume differ from one render"
+    );
     // The passes traced each pixel's count once, the same samples.
     assert_eq!(samples, counts.iter().map(|&c| u64::from(c)).sum::<u64>());
 }

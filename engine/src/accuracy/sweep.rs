@@ -15,7 +15,7 @@ use crate::accel::BuildQuality;
 use crate::extract::{Overrides, RenderScene, extract};
 use crate::film::denoise::Denoiser;
 use crate::integrators::Integrator;
-use crate::integrators::adaptive::Adaptive;
+use crate::integrators::adaptive::{Adaptive, ErrorGoal};
 use crate::scene::{FilterSampling, LightSelection, Scene, default_module};
 use crate::world::{EmitterSpec, LightSpec};
 use radiant_core::{Filter, Registry, Sampler};
@@ -129,8 +129,9 @@ pub enum Change {
     Denoise,
     /// The integrator type (default parameters).
     Integrator(String),
-    /// Adaptive sampling on (the default rule) or off.
-    Adaptive(bool),
+    /// Adaptive sampling toward an error goal (default parameters), or
+    /// off (`None`).
+    Adaptive(Option<ErrorGoal>),
 }
 
 /// One setting of the sweep.
@@ -165,8 +166,10 @@ impl Setting {
             Change::LightSelection(LightSelection::Spatial) => "spatial".into(),
             Change::Bvh(q) => format!("{q:?}").to_lowercase(),
             Change::Gpu => "gpu".into(),
-            Change::Denoise | Change::Adaptive(true) => "on".into(),
-            Change::Adaptive(false) => "off".into(),
+            Change::Denoise => "on".into(),
+            Change::Adaptive(Some(ErrorGoal::Relative)) => "relative".into(),
+            Change::Adaptive(Some(ErrorGoal::Mse)) => "mse".into(),
+            Change::Adaptive(None) => "off".into(),
         }
     }
 
@@ -201,7 +204,12 @@ impl Setting {
             Change::Filter(t) => scene.filter = default_module(t),
             Change::Sampler(t) => scene.sampler = default_module(t),
             Change::Integrator(t) => scene.integrator = default_module(t),
-            Change::Adaptive(on) => scene.settings.adaptive = on.then(Adaptive::default),
+            Change::Adaptive(goal) => {
+                scene.settings.adaptive = goal.map(|error| Adaptive {
+                    error,
+                    ..Adaptive::default()
+                })
+            }
             _ => {}
         }
         let render = extract(scene, registry, &overrides);
@@ -308,7 +316,11 @@ pub fn settings(scene: &Scene, registry: &Registry, axes: &[Axis]) -> (Vec<Setti
                 .filter(|t| *t != scene.integrator.type_name)
                 .map(|t| Change::Integrator(t.to_string()))
                 .collect(),
-            Axis::Adaptive => vec![Change::Adaptive(s.adaptive.is_none())],
+            Axis::Adaptive => [None, Some(ErrorGoal::Relative), Some(ErrorGoal::Mse)]
+                .into_iter()
+                .filter(|goal| *goal != s.adaptive.map(|a| a.error))
+                .map(Change::Adaptive)
+                .collect(),
         };
         if changes.is_empty() {
             notes.push(format!("{axis}: only the scene's own value is registered"));
@@ -466,7 +478,8 @@ mod tests {
         let one = scene("{type: path, max_depth: 5, rr_depth: 2}", POINT);
         let (list, notes) = settings(&one, &registry, &Axis::ALL);
         // The integrator axis holds every registered integrator but the
-        // scene's, and the adaptive axis turns adaptive sampling on.
+        // scene's, and the adaptive axis turns adaptive sampling on with
+        // each error goal.
         let integrators: Vec<String> = list
             .iter()
             .filter(|s| s.axis == Axis::Integrator)
@@ -483,7 +496,7 @@ mod tests {
             .filter(|s| s.axis == Axis::Adaptive)
             .map(Setting::label)
             .collect();
-        assert_eq!(adaptive, ["adaptive=on"]);
+        assert_eq!(adaptive, ["adaptive=relative", "adaptive=mse"]);
         let mut labels: Vec<String> = list
             .iter()
             .filter(|s| !matches!(s.axis, Axis::Integrator | Axis::Adaptive))

@@ -21,10 +21,11 @@ use crate::film::band::Bands;
 use crate::film::encode::{BLOCK_ROWS, RowSink, write_encoded};
 use crate::film::memory::FrameTooLarge;
 use crate::film::{Film, Image, Reconstruction, TileFilm};
-use crate::integrators::adaptive::{self, TileRect};
+use crate::integrators::adaptive::{self, ErrorGoal, TileRect};
+use crate::integrators::budget::{self, Pilot};
 use crate::integrators::module::batches;
 use crate::integrators::{
-    ChainContext, Family, SplatFilm, TileContext, TileIntegrator, TileOutput, TileWorker,
+    Batch, ChainContext, Family, SplatFilm, TileContext, TileIntegrator, TileOutput, TileWorker,
 };
 use radiant_core::Rgb;
 use rayon::prelude::*;
@@ -295,30 +296,7 @@ fn film_decisions(
     }
     let s = &scene.settings;
     let none = Progress::none();
-    let tiler = Tiler::new(scene, tiles, None, 0..s.spp, &none);
-    let columns = s.width.div_ceil(TILE);
-    let origins: Vec<(u32, u32)> = (0..s.height.div_ceil(TILE))
-        .flat_map(|ty| (0..columns).map(move |tx| (tx * TILE, ty * TILE)))
-        .collect();
-    let decided: Vec<(TileRect, Vec<u32>)> = origins
-        .par_iter()
-        .map_init(
-            || tiles.worker(),
-            |worker, &origin| {
-                let rect = tiler.rect(origin);
-                (rect, tiler.decide(worker.as_mut(), a, rect))
-            },
-        )
-        .collect();
-    let mut frame = vec![0u32; s.width as usize * s.height as usize];
-    for (t, counts) in decided {
-        let tw = (t.x1 - t.x0) as usize;
-        for (row, y) in counts.chunks(tw.max(1)).zip(t.y0..) {
-            let start = (y * t.width + t.x0) as usize;
-            frame[start..start + row.len()].copy_from_slice(row);
-        }
-    }
-    Some(frame)
+    Some(Tiler::new(scene, tiles, None, 0..s.spp, &none).frame_counts(a))
 }
 
 /// Renders `scene` on all threads of the current rayon pool and writes the
@@ -455,6 +433,7 @@ pub fn render_rows(
     let mut tiler = Tiler::new(scene, tiles, None, 0..s.spp, progress);
     tiler.stop = Some(interrupt.flag);
     let bands = tiler.bands(group);
+    tiler.allocate_frame();
     let threads = rayon::current_num_threads();
     // A thread's first allocation makes glibc reserve it an arena of
     // address space (64 MiB); let every thread take its own before
@@ -534,6 +513,10 @@ struct Tiler<'a> {
     /// takes in the whole render (row-major), decided by the first pass;
     /// `None` where each tile decides its own (a whole render).
     decided: Option<&'a [u32]>,
+    /// Under adaptive sampling toward the least MSE, the image samples each
+    /// pixel takes (row-major, the whole frame), decided when the render
+    /// starts ([`Tiler::allocate_frame`]) where `decided` is `None`.
+    allocated: std::sync::OnceLock<Vec<u32>>,
     progress: &'a Progress<'a>,
     /// Raised to stop (a banded write's Ctrl-C): tiles not yet started
     /// are skipped, and `cut` says that one was.
@@ -565,6 +548,7 @@ impl<'a> Tiler<'a> {
             traced: AtomicU64::new(0),
             counts: None,
             decided: None,
+            allocated: std::sync::OnceLock::new(),
             progress,
             stop: None,
             cut: AtomicBool::new(false),
@@ -586,6 +570,7 @@ impl<'a> Tiler<'a> {
         mut merge: impl FnMut(&[T]),
     ) -> Pass {
         let start = Instant::now();
+        self.allocate_frame();
         let mut rays = 0;
         let group = group_tile_rows(self.scene.settings.width) * WHOLE_GROUP_FACTOR;
         for group in self.bands(group).groups() {
@@ -676,14 +661,17 @@ impl<'a> Tiler<'a> {
             // Decisions first (their samples never reach the image), then
             // this pass's share of each pixel's image samples, weighted by
             // 1 / its count.
-            let counts = match self.decided {
+            let frame = self
+                .decided
+                .or_else(|| self.allocated.get().map(Vec::as_slice));
+            let counts = match frame {
                 Some(frame) => tile_counts(frame, rect),
                 None => self.decide(worker, a, rect),
             };
             let spp = self.scene.settings.spp;
             let share = |c| adaptive::pass_share(&self.samples, spp, c);
-            adaptive::render_image(&counts, rect, share, |batch, count| {
-                tile.set_scale(1.0 / count as f32);
+            tile.set_pixel_scales(counts.iter().map(|&c| 1.0 / c.max(1) as f32).collect());
+            adaptive::render_image(&counts, rect, share, |batch| {
                 let out = TileOutput {
                     film: &mut tile,
                     aovs: aovs.as_deref_mut(),
@@ -691,7 +679,7 @@ impl<'a> Tiler<'a> {
                 };
                 worker.render(&ctx, batch, out);
             });
-            tile.set_scale(1.0);
+            tile.set_pixel_scales(Vec::new());
             let traced = counts.iter().map(|&c| share(c).len() as u64).sum();
             self.finish_tile(rect, &counts, traced);
             return (tile, worker.rays() - rays_before);
@@ -729,9 +717,86 @@ impl<'a> Tiler<'a> {
         }
     }
 
+    /// Under adaptive sampling, the image samples each pixel of the frame
+    /// takes (row-major): every tile decided on the pool's threads, and
+    /// under `error: mse` the frame's budget split by the pilot σs.
+    fn frame_counts(&self, a: &adaptive::Adaptive) -> Vec<u32> {
+        let s = &self.scene.settings;
+        match a.error {
+            ErrorGoal::Relative => self.per_pixel(|w, t| self.decide(w, a, t), 0),
+            ErrorGoal::Mse => {
+                let pilot = self.per_pixel(|w, t| self.pilot(w, t), Pilot::default());
+                let footprint = budget::Footprint::new(&self.reconstruction);
+                let sigma = footprint.effective_sigma(&pilot, s.width as usize);
+                budget::allocate(&sigma, s.spp, budget::limits(a, s.spp))
+            }
+        }
+    }
+
+    /// Under adaptive sampling toward the least MSE, decides the whole
+    /// frame's counts into `allocated` (once; before rendering, within the
+    /// render's time), unless a pass before decided them.
+    fn allocate_frame(&self) {
+        if let Some(a) = &self.scene.settings.adaptive
+            && a.error == ErrorGoal::Mse
+            && self.decided.is_none()
+        {
+            self.allocated.get_or_init(|| self.frame_counts(a));
+        }
+    }
+
+    /// `value(worker, tile)` of every tile (row-major in the tile), on the
+    /// pool's threads, placed in a row-major frame (`empty` where none).
+    fn per_pixel<T: Copy + Send>(
+        &self,
+        value: impl Fn(&mut dyn TileWorker, TileRect) -> Vec<T> + Sync,
+        empty: T,
+    ) -> Vec<T> {
+        let s = &self.scene.settings;
+        let columns = s.width.div_ceil(TILE);
+        let rects: Vec<TileRect> = (0..s.height.div_ceil(TILE))
+            .flat_map(|ty| (0..columns).map(move |tx| self.rect((tx * TILE, ty * TILE))))
+            .collect();
+        let values: Vec<Vec<T>> = rects
+            .par_iter()
+            .map_init(|| self.integrator.worker(), |w, &t| value(w.as_mut(), t))
+            .collect();
+        let mut frame = vec![empty; s.width as usize * s.height as usize];
+        for (t, tile) in rects.iter().zip(values) {
+            let tw = (t.x1 - t.x0) as usize;
+            for (row, y) in tile.chunks(tw.max(1)).zip(t.y0..) {
+                let start = (y * t.width + t.x0) as usize;
+                frame[start..start + row.len()].copy_from_slice(row);
+            }
+        }
+        frame
+    }
+
+    /// Renders adaptive sampling's pilot round of tile `t` (decision
+    /// samples into a scratch film): each pixel's mean and σ.
+    fn pilot(&self, worker: &mut dyn TileWorker, t: TileRect) -> Vec<Pilot> {
+        self.decision_round(worker, t, |render| {
+            budget::pilot(self.scene.settings.spp, t, render)
+        })
+    }
+
     /// Makes adaptive sampling's decisions for tile `t` (decision samples
     /// into a scratch film): the image samples each of its pixels takes.
     fn decide(&self, worker: &mut dyn TileWorker, a: &adaptive::Adaptive, t: TileRect) -> Vec<u32> {
+        let spp = self.scene.settings.spp;
+        self.decision_round(worker, t, |render| adaptive::decide(a, spp, t, render))
+    }
+
+    /// Runs `decide` on tile `t`, handing it a renderer of decision
+    /// samples: they go to a scratch film (and splats to the decision
+    /// sink), never to the image, and each sample's value is reported by
+    /// pixel.
+    fn decision_round<T>(
+        &self,
+        worker: &mut dyn TileWorker,
+        t: TileRect,
+        decide: impl FnOnce(&mut dyn FnMut(Batch, &mut dyn FnMut(u32, Rgb))) -> T,
+    ) -> T {
         let s = &self.scene.settings;
         let reach = self.reconstruction.reach();
         let mut scratch = TileFilm::new(t.x0, t.y0, t.x1, t.y1, (s.width, s.height), reach);
@@ -739,7 +804,7 @@ impl<'a> Tiler<'a> {
             splats: self.decision_sink.as_ref(),
             ..self.context()
         };
-        adaptive::decide(a, s.spp, t, |batch, add| {
+        decide(&mut |batch, add| {
             let out = TileOutput {
                 film: &mut scratch,
                 aovs: None,

@@ -77,10 +77,28 @@ pub const DECISION_SHARE: u32 = 4;
 /// Floor of the mean luminance in the relative test.
 pub const MEAN_FLOOR: f64 = 1e-3;
 
-/// `sampler: {adaptive: {threshold, confidence, batch, min_spp, max_spp}}`.
+/// Which error adaptive sampling lowers (`adaptive: {error: …}`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ErrorGoal {
+    /// Every pixel to `threshold` relative error, checked every `batch`
+    /// samples (seed 002's rule; `spp` is the most a pixel takes).
+    #[default]
+    Relative,
+    /// The least mean squared error for `spp` samples per pixel on
+    /// average: one pilot round, then each pixel's samples in proportion
+    /// to its σ ([`super::budget`]).
+    Mse,
+}
+
+/// `sampler: {adaptive: {error, threshold, confidence, batch, min_spp,
+/// max_spp}}`.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Adaptive {
+    /// The error to lower: `relative` (the default) or `mse`.
+    #[serde(default)]
+    pub error: ErrorGoal,
     /// Relative error at which a pixel stops: the confidence interval's
     /// half-width over the mean.
     #[serde(default = "default_threshold")]
@@ -92,10 +110,12 @@ pub struct Adaptive {
     #[serde(default = "default_batch")]
     pub batch: u32,
     /// Samples every pixel takes before the first check (default: `batch`;
-    /// rounded up to a multiple of `batch`).
+    /// rounded up to a multiple of `batch`); under `error: mse` the least
+    /// a pixel takes (default `spp` / 4).
     #[serde(default)]
     pub min_spp: Option<u32>,
-    /// Samples a pixel takes at most (default: the sampler's `spp`).
+    /// Samples a pixel takes at most (default: the sampler's `spp`; under
+    /// `error: mse` 16 · `spp`).
     #[serde(default)]
     pub max_spp: Option<u32>,
 }
@@ -119,6 +139,7 @@ fn default_batch() -> u32 {
 impl Default for Adaptive {
     fn default() -> Self {
         Self {
+            error: ErrorGoal::Relative,
             threshold: default_threshold(),
             confidence: default_confidence(),
             batch: default_batch(),
@@ -301,6 +322,26 @@ pub struct TileRect {
     pub width: u32,
 }
 
+impl TileRect {
+    /// Pixels in the tile.
+    pub fn len(&self) -> usize {
+        ((self.x1 - self.x0) * (self.y1 - self.y0)) as usize
+    }
+
+    /// Whether the tile has no pixels.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The row-major index in the tile of frame pixel `pixel` (its
+    /// row-major index in the frame), which must lie in the tile.
+    #[inline]
+    pub fn index(&self, pixel: u32) -> usize {
+        let (x, y) = (pixel % self.width, pixel / self.width);
+        ((y - self.y0) * (self.x1 - self.x0) + x - self.x0) as usize
+    }
+}
+
 /// Decides how many image samples each pixel of tile `t` takes in a
 /// render of `spp` samples per pixel, by rounds of decision samples alone:
 /// `render(batch, on_sample)` renders a batch of decision samples (which
@@ -314,9 +355,7 @@ pub fn decide(
     t: TileRect,
     mut render: impl FnMut(Batch, &mut dyn FnMut(u32, Rgb)),
 ) -> Vec<u32> {
-    let tw = t.x1 - t.x0;
-    let len = (tw * (t.y1 - t.y0)) as usize;
-    let index = |pixel: u32| ((pixel / t.width - t.y0) * tw + pixel % t.width - t.x0) as usize;
+    let len = t.len();
     let mut decision = vec![Moments::default(); len];
     let mut counts = vec![0u32; len];
     let mut active = vec![true; len];
@@ -332,7 +371,7 @@ pub fn decide(
         let per_round = decision_samples(target - n);
         let samples = DECISION_BASE + decided..DECISION_BASE + decided + per_round;
         for_runs(&active, t, samples, &mut |b| {
-            render(b, &mut |p, v| decision[index(p)].add(sample_luminance(v)))
+            render(b, &mut |p, v| decision[t.index(p)].add(sample_luminance(v)))
         });
         decided += per_round;
         for (c, _) in counts.iter_mut().zip(&active).filter(|(_, a)| **a) {
@@ -356,14 +395,16 @@ pub fn decide(
 
 /// Renders the image samples of tile `t` whose pixels take `counts`
 /// samples (from [`decide`]): of a pixel taking `c`, the sample indices
-/// `samples(c)`. `render(batch, c)` renders a batch whose pixels all take
-/// `c` (a splatting film weights their samples by 1/`c`, see
-/// `backend/cpu.rs`).
+/// `samples(c)`, by `render(batch)` for the runs of pixels of each count
+/// in turn. (Rendering each count's pixels on their own keeps the film's
+/// blocks of sample indices the same in passes as in one render, see
+/// [`pass_share`]; a splatting film weighs each pixel's samples by 1 / its
+/// count, see `backend/cpu.rs`.)
 pub fn render_image(
     counts: &[u32],
     t: TileRect,
     samples: impl Fn(u32) -> std::ops::Range<u32>,
-    mut render: impl FnMut(Batch, u32),
+    mut render: impl FnMut(Batch),
 ) {
     let mut classes = counts.to_vec();
     classes.sort_unstable();
@@ -377,7 +418,7 @@ pub fn render_image(
         for (m, &n) in members.iter_mut().zip(counts) {
             *m = n == c;
         }
-        for_runs(&members, t, range, &mut |b| render(b, c));
+        for_runs(&members, t, range, &mut render);
     }
 }
 

@@ -9,10 +9,13 @@
 //! registered in the [`Registry`](radiant_core::Registry)) with a driver
 //! per family — image tiles, Markov chains — and [`splat`] is the
 //! whole-image film that light paths and chains splat into; [`adaptive`]
-//! stops sampling converged pixels in the tile driver.
+//! stops sampling converged pixels in the tile driver, and [`budget`]
+//! spreads a fixed budget of samples where they lower the mean squared
+//! error most.
 
 pub mod adaptive;
 pub mod bdpt;
+pub mod budget;
 mod medium;
 pub mod mlt;
 pub mod module;

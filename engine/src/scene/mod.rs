@@ -38,7 +38,7 @@ pub mod transform;
 mod yaml;
 
 pub use crate::error::SceneError;
-pub use crate::integrators::adaptive::Adaptive;
+pub use crate::integrators::adaptive::{Adaptive, ErrorGoal};
 pub use crate::settings::{FilterSampling, LightSelection, MAX_FILM_SIZE, RenderSettings};
 pub use crate::world::{Scene, Timeline};
 pub use gltf::register as register_gltf_image;
@@ -841,7 +841,7 @@ fn parse_sampler(
     Ok((p.spp, adaptive, spec))
 }
 
-/// The sampler's `adaptive: {threshold, confidence, batch, min_spp,
+/// The sampler's `adaptive: {error, threshold, confidence, batch, min_spp,
 /// max_spp}` (or `adaptive: true` for the defaults), if given.
 fn parse_adaptive(file: &Path, sampler: &Node) -> Result<Option<Adaptive>, SceneError> {
     let Some(node) = sampler.as_mapping().and_then(|m| m.get_node("adaptive")) else {
@@ -854,6 +854,22 @@ fn parse_adaptive(file: &Path, sampler: &Node) -> Result<Option<Adaptive>, Scene
         return Ok(on.then(Adaptive::default));
     }
     let a: Adaptive = parse_node(file, node)?;
+    if a.error == ErrorGoal::Mse {
+        // The relative rule's keys mean nothing to the budget split.
+        for key in ["threshold", "confidence", "batch"] {
+            if let Some(at) = node.as_mapping().and_then(|m| m.get_node(key)) {
+                return Err(SceneError::new(
+                    file,
+                    loc(at.span()),
+                    format!(
+                        "`{key}` belongs to the relative rule; with `error: mse` adaptive \
+                         sampling spends `spp` samples per pixel on average where they lower \
+                         the mean squared error most (allowed: error, min_spp, max_spp)"
+                    ),
+                ));
+            }
+        }
+    }
     a.check().map_err(|(key, message)| {
         let at = node
             .as_mapping()
