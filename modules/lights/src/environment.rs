@@ -255,11 +255,12 @@ impl EnvironmentLight {
                 let mut u = d.x.atan2(-d.z) / TAU;
                 u -= u.floor();
                 // θ from atan2, not acos(y): exact near the poles too.
-                let v = (d.x * d.x + d.z * d.z).sqrt().atan2(d.y) / PI;
+                let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
+                let v = sin_theta.atan2(d.y) / PI;
                 let at = m.locate(u, v);
                 EmitterEval {
                     radiance: m.radiance(&at),
-                    pdf: m.pdf(&at, v),
+                    pdf: m.pdf(&at, sin_theta),
                 }
             }
         }
@@ -394,11 +395,11 @@ impl Map {
         top * (1.0 - t.y) + bottom * t.y
     }
 
-    /// Solid-angle density at `at`, whose v is `v`: the cell's density
-    /// over (u, v) times the bilinear patch's within it, over 2π² sin θ.
+    /// Solid-angle density at `at`, where sin θ is `sin_theta`: the
+    /// cell's density over (u, v) times the bilinear patch's within it,
+    /// over 2π² sin θ.
     #[inline]
-    fn pdf(&self, at: &Patch, v: f32) -> f32 {
-        let sin_theta = (PI * v).sin();
+    fn pdf(&self, at: &Patch, sin_theta: f32) -> f32 {
         if sin_theta <= 0.0 {
             return 0.0;
         }
@@ -431,7 +432,7 @@ impl Map {
         let (sin_t, cos_t) = (PI * v).sin_cos();
         let (sin_p, cos_p) = (TAU * u).sin_cos();
         let dir = Vec3::new(sin_p * sin_t, cos_t, -cos_p * sin_t);
-        (dir, self.radiance(&at), self.pdf(&at, v))
+        (dir, self.radiance(&at), self.pdf(&at, sin_t))
     }
 }
 

@@ -119,9 +119,8 @@ fn env_weights(p: u32, at: EnvPatch) -> vec4f {
     );
 }
 
-// Map::pdf: the solid-angle density at `at`, whose v is `v`.
-fn env_pdf(p: u32, at: EnvPatch, v: f32) -> f32 {
-    let sin_theta = sin(PI * v);
+// Map::pdf: the solid-angle density at `at`, where sin θ is `sin_theta`.
+fn env_pdf(p: u32, at: EnvPatch, sin_theta: f32) -> f32 {
     if sin_theta <= 0.0 {
         return 0.0;
     }
@@ -146,9 +145,10 @@ fn env_eval_local(p: u32, d: vec3f) -> EmitterEval {
     u -= floor(u);
     // θ from atan2, not acos(y): exact near the poles too (and some
     // GPUs' acos is off by 1e-4).
-    let v = atan2(sqrt(d.x * d.x + d.z * d.z), d.y) / PI;
+    let sin_theta = sqrt(d.x * d.x + d.z * d.z);
+    let v = atan2(sin_theta, d.y) / PI;
     let at = env_locate(p, u, v);
-    return EmitterEval(env_radiance(p, at), env_pdf(p, at, v));
+    return EmitterEval(env_radiance(p, at), env_pdf(p, at, sin_theta));
 }
 
 fn light_sample_environment(p: u32, r: vec3f, u: vec2f) -> LightSample {
@@ -178,7 +178,7 @@ fn light_sample_environment(p: u32, r: vec3f, u: vec2f) -> LightSample {
         let phi = 2.0 * PI * su;
         local = vec3f(sin(phi) * sin_t, cos_t, -cos(phi) * sin_t);
         radiance = env_radiance(p, at);
-        pdf = env_pdf(p, at, v);
+        pdf = env_pdf(p, at, sin_t);
     }
     let to_render = mat3x3f(param_vec3(p + 1u), param_vec3(p + 4u), param_vec3(p + 7u));
     let wi = to_render * local;
