@@ -254,9 +254,17 @@ impl EnvironmentLight {
             Emission::Map(m) => {
                 let mut u = d.x.atan2(-d.z) / TAU;
                 u -= u.floor();
-                // θ from atan2, not acos(y): exact near the poles too.
+                // Near the poles θ comes from sin θ: acos(y) is imprecise
+                // there (y rounds to ±1 within 3e-4 of them).
                 let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
-                let v = sin_theta.atan2(d.y) / PI;
+                let theta = if d.y.abs() < 0.7 {
+                    d.y.acos()
+                } else if d.y > 0.0 {
+                    sin_theta.asin()
+                } else {
+                    PI - sin_theta.asin()
+                };
+                let v = theta / PI;
                 let at = m.locate(u, v);
                 EmitterEval {
                     radiance: m.radiance(&at),
