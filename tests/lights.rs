@@ -96,6 +96,52 @@ fn environment_map_sampling_matches_its_pdf() {
     }
 }
 
+/// A 6 × 5 map with bright, uneven poles above black rows and a black
+/// column: every cell at a pole has two black corners on its inner row,
+/// and half the cells have a black side.
+fn black_rings_under_the_poles() -> EnvironmentLight {
+    let (w, h) = (6u32, 5u32);
+    let pixels = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32, (i / w) as f32);
+            if y == 1.0 || y == 3.0 || x == 2.0 {
+                Rgb::ZERO
+            } else {
+                Rgb::new(1.0 + x, 0.5 + 0.3 * x * y, 2.0 - 0.2 * y)
+            }
+        })
+        .collect();
+    EnvironmentLight::from_pixels(pixels, UVec2::new(w, h), Mat3::IDENTITY, SPHERE).unwrap()
+}
+
+#[test]
+fn a_map_is_sampled_wherever_its_radiance_is_not_zero() {
+    let light = black_rings_under_the_poles();
+    check_environment(&light).unwrap();
+    // θ on a grid, finer near the poles, where the pole's radiance fades
+    // out towards the black rows while the pole itself weighs nothing.
+    let mut thetas: Vec<f32> = (0..200).map(|k| (k as f32 + 0.5) / 200.0).collect();
+    thetas.extend([1e-4, 1e-3, 1e-2, 0.05].iter().flat_map(|&t| [t, 1.0 - t]));
+    let mut lit = 0;
+    for t in thetas {
+        let (sin_t, cos_t) = (std::f32::consts::PI * t).sin_cos();
+        for k in 0..400 {
+            let phi = std::f32::consts::TAU * (k as f32 + 0.5) / 400.0;
+            let d = Vec3::new(phi.sin() * sin_t, cos_t, -phi.cos() * sin_t);
+            let e = eval(&light, d);
+            if e.radiance.max_element() > 0.0 {
+                lit += 1;
+                assert!(
+                    e.pdf > 0.0,
+                    "{d} (θ = {t}π) has radiance {} but no density",
+                    e.radiance
+                );
+            }
+        }
+    }
+    assert!(lit > 40_000, "only {lit} directions are lit");
+}
+
 #[test]
 fn constant_environment_sampling_matches_its_pdf() {
     let light = EnvironmentLight::constant(Rgb::new(1.0, 0.5, 0.25), SPHERE);

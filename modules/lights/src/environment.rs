@@ -9,20 +9,32 @@
 //! and radiance is interpolated bilinearly between pixels (checked against
 //! Mitsuba's own `eval` in `tests/lights.rs`).
 //!
-//! Importance sampling: the W × (H − 1) cells between pixel centres get
-//! weights luminance × solid angle (the mean of their four corners' lumina
-//! times the cell's band of cos θ), sampled with a [`Distribution2D`];
-//! within a cell, φ and cos θ are uniform, so the density is constant over
-//! each cell's solid angle.
+//! Importance sampling (as Mitsuba's `envmap` with its continuous
+//! `Marginal2D`): each pixel gets the weight luminance × sin θ of its row,
+//! and the density over (u, v) is the bilinear interpolation of these
+//! weights between pixel centres, the same interpolation as the radiance,
+//! so it follows luminance × sin θ (the solid angle per unit of u and v)
+//! within a cell too. A [`Distribution2D`] picks one of the W × (H − 1)
+//! cells between pixel centres by its integral (the mean of its four
+//! corners); [`bilinear`] draws the point within it. The solid-angle
+//! density is the (u, v) density over 2π² sin θ.
+//!
+//! The pole rows weigh 0 (sin θ = 0); so that a cell touching a pole never
+//! has zero density where the pole's radiance is not zero, the row next to
+//! a pole weighs at least half the pole's luminance (times its own sin θ).
+//! Everywhere else a weight is 0 only where the luminance is.
 //!
 //! The GPU side (`environment.wgsl`) samples and evaluates the same way from
-//! the same tables: the map's texels, cos θ per row, and the marginal and
-//! conditional CDFs of the distribution itself
+//! the same tables: the map's texels, the pixel weights, and the marginal
+//! and conditional CDFs of the distribution itself
 //! ([`Distribution1D::cdf`](radiant_core::distribution::Distribution1D::cdf);
 //! a test holds the two to the same densities and samples).
 
+mod bilinear;
+
 use crate::map_file::load_map;
 use crate::params::check_colour;
+use bilinear::{bilinear_pdf, sample_bilinear};
 use radiant_core::distribution::Distribution2D;
 use radiant_core::glam::{DMat3, Mat3, UVec2, Vec2, Vec3};
 use radiant_core::warp::{UNIFORM_SPHERE_PDF, square_to_uniform_sphere};
@@ -76,8 +88,10 @@ struct Map {
     size: UVec2,
     /// Radiance per pixel, row-major, scale applied.
     texels: Vec<Rgb>,
-    /// cos θ of each pixel row.
-    cos_theta: Vec<f32>,
+    /// Sampling weight per pixel, row-major (see [`pixel_weights`]).
+    weights: Vec<f32>,
+    /// Over the cells between pixel centres, by the mean of their corners'
+    /// weights.
     distribution: Distribution2D,
     /// The GPU parameters of the map, made on first use.
     gpu: GpuCache,
@@ -206,17 +220,18 @@ impl EnvironmentLight {
                 pixels[i]
             ));
         }
-        let cos_theta: Vec<f32> = (0..h)
-            .map(|y| (PI * y as f32 / (h - 1) as f32).cos())
-            .collect();
-        let weights = cell_weights(&pixels, size, &cos_theta);
-        let distribution = Distribution2D::new(&weights, UVec2::new(size.x, size.y - 1));
-        let integral = (TAU / w as f32) * distribution.total() as f32;
+        let weights = pixel_weights(&pixels, size);
+        let distribution = Distribution2D::new(
+            &cell_weights(&weights, size),
+            UVec2::new(size.x, size.y - 1),
+        );
+        // ∫ L dω = ∫∫ L sin θ 2π² du dv, the cells' means times their area.
+        let integral = (2.0 * PI * PI / (w * (h - 1)) as f32) * distribution.total() as f32;
         Ok(Self {
             emission: Emission::Map(Arc::new(Map {
                 size,
                 texels: pixels,
-                cos_theta,
+                weights,
                 distribution,
                 gpu: GpuCache::default(),
             })),
@@ -239,130 +254,193 @@ impl EnvironmentLight {
             Emission::Map(m) => {
                 let mut u = d.x.atan2(-d.z) / TAU;
                 u -= u.floor();
-                let v = d.y.clamp(-1.0, 1.0).acos() / PI;
+                // Near the poles θ comes from sin θ: acos(y) is imprecise
+                // there (y rounds to ±1 within 3e-4 of them).
+                let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
+                let theta = if d.y.abs() < 0.7 {
+                    d.y.acos()
+                } else if d.y > 0.0 {
+                    sin_theta.asin()
+                } else {
+                    PI - sin_theta.asin()
+                };
+                let v = theta / PI;
+                let at = m.locate(u, v);
                 EmitterEval {
-                    radiance: m.lookup(u, v),
-                    pdf: m.pdf(u, v),
+                    radiance: m.radiance(&at),
+                    pdf: m.pdf(&at, sin_theta),
                 }
             }
         }
     }
 }
 
-/// The sampling weight of each of the `size.x × (size.y − 1)` cells
-/// between pixel centres: the mean luminance of its four corners times
-/// its band of cos θ.
-fn cell_weights(pixels: &[Rgb], size: UVec2, cos_theta: &[f32]) -> Vec<f32> {
+/// The sampling weight of each pixel: its luminance times sin θ of its
+/// row, 0 on the pole rows; the rows next to a pole take at least half the
+/// pole's luminance, so that no cell at a pole is weightless where the
+/// pole's radiance is not zero.
+fn pixel_weights(pixels: &[Rgb], size: UVec2) -> Vec<f32> {
     let (w, h) = (size.x as usize, size.y as usize);
-    let lum: Vec<f32> = pixels.iter().map(|p| luminance(*p)).collect();
-    let mut weights = Vec::with_capacity(w * (h - 1));
-    for y in 0..h - 1 {
-        let band = (cos_theta[y] - cos_theta[y + 1]).max(0.0);
+    let lum = |x: usize, y: usize| luminance(pixels[y * w + x]);
+    let mut weights = Vec::with_capacity(w * h);
+    for y in 0..h {
+        let sin_theta = if y == 0 || y == h - 1 {
+            0.0
+        } else {
+            (PI * y as f32 / (h - 1) as f32).sin()
+        };
         for x in 0..w {
-            let x1 = (x + 1) % w;
-            let corners =
-                lum[y * w + x] + lum[y * w + x1] + lum[(y + 1) * w + x] + lum[(y + 1) * w + x1];
-            weights.push(0.25 * corners * band);
+            let mut l = lum(x, y);
+            if y == 1 {
+                l = l.max(0.5 * lum(x, 0));
+            }
+            if y + 2 == h {
+                l = l.max(0.5 * lum(x, h - 1));
+            }
+            weights.push(l * sin_theta);
         }
     }
     weights
 }
 
+/// The sampling weight of each of the `size.x × (size.y − 1)` cells
+/// between pixel centres: the integral of the bilinear patch over it, the
+/// mean of its four corners' weights.
+fn cell_weights(weights: &[f32], size: UVec2) -> Vec<f32> {
+    let (w, h) = (size.x as usize, size.y as usize);
+    let mut cells = Vec::with_capacity(w * (h - 1));
+    for y in 0..h - 1 {
+        for x in 0..w {
+            let x1 = (x + 1) % w;
+            let corners = weights[y * w + x]
+                + weights[y * w + x1]
+                + weights[(y + 1) * w + x]
+                + weights[(y + 1) * w + x1];
+            cells.push(0.25 * corners);
+        }
+    }
+    cells
+}
+
+/// Where a (u, v) lies in the map: its cell (between the centres of
+/// pixels x0 and x1 = x0 + 1 (wrapping), rows y0 and y0 + 1) and its
+/// place `t` in [0, 1]² within the cell.
+struct Patch {
+    x0: usize,
+    x1: usize,
+    y0: usize,
+    t: Vec2,
+}
+
 impl Map {
     /// The map's words for `environment.wgsl` (see its header): size,
-    /// the offsets of the tables, then cos θ per row, the marginal CDF of
-    /// the cell rows, each cell row's conditional CDF and the texels.
+    /// the offsets of the tables, then the pixel weights, the marginal CDF
+    /// of the cell rows, each cell row's conditional CDF and the texels.
     fn gpu_params(&self) -> &GpuParams {
         self.gpu.0.get_or_init(|| {
-            let h = self.size.y as usize;
             let d = &self.distribution;
             let marginal = d.marginal().cdf();
             let rows: Vec<f32> = d.rows().iter().flat_map(|r| r.cdf()).copied().collect();
             // Offsets from the light's first word: 17 words precede the tables.
-            let cos_at = 17;
-            let marginal_at = cos_at + h;
+            let weights_at = 17;
+            let marginal_at = weights_at + self.weights.len();
             let rows_at = marginal_at + marginal.len();
             let texels_at = rows_at + rows.len();
             GpuParams::new()
                 .u32(self.size.x)
                 .u32(self.size.y)
-                .u32(cos_at as u32)
+                .u32(weights_at as u32)
                 .u32(marginal_at as u32)
                 .u32(rows_at as u32)
                 .u32(texels_at as u32)
-                .f32s(self.cos_theta.iter().copied())
+                .f32s(self.weights.iter().copied())
                 .f32s(marginal.iter().copied())
                 .f32s(rows)
                 .f32s(self.texels.iter().flat_map(|t| t.to_array()))
         })
     }
 
-    /// Bilinear interpolation between pixels, wrapping in u.
+    /// The cell of (u, v) and the place within it, as the radiance is
+    /// interpolated: cell x lies between the centres of pixels x and
+    /// x + 1, wrapping in u.
     #[inline]
-    fn lookup(&self, u: f32, v: f32) -> Rgb {
+    fn locate(&self, u: f32, v: f32) -> Patch {
         let (w, h) = (self.size.x as usize, self.size.y as usize);
         let fx = u * w as f32 - 0.5;
         let fy = v * (h - 1) as f32;
         let xf = fx.floor();
         let x0 = (xf as isize).rem_euclid(w as isize) as usize;
         let y0 = (fy as usize).min(h - 2);
-        let (tx, ty) = (fx - xf, fy - y0 as f32);
-        let x1 = (x0 + 1) % w;
-        let t = |x: usize, y: usize| self.texels[y * w + x];
-        let top = t(x0, y0) * (1.0 - tx) + t(x1, y0) * tx;
-        let bottom = t(x0, y0 + 1) * (1.0 - tx) + t(x1, y0 + 1) * tx;
-        top * (1.0 - ty) + bottom * ty
-    }
-
-    /// The cell holding (u, v); cell x lies between the centres of pixels
-    /// x and x + 1.
-    #[inline]
-    fn cell(&self, u: f32, v: f32) -> UVec2 {
-        let w = self.size.x as f32;
-        let x = ((u * w - 0.5).floor() as i64).rem_euclid(self.size.x as i64) as u32;
-        let y = ((v * (self.size.y - 1) as f32) as u32).min(self.size.y - 2);
-        UVec2::new(x, y)
-    }
-
-    /// Solid-angle density of the cell holding (u, v).
-    #[inline]
-    fn pdf(&self, u: f32, v: f32) -> f32 {
-        let c = self.cell(u, v);
-        self.cell_pdf(c)
-    }
-
-    #[inline]
-    fn cell_pdf(&self, c: UVec2) -> f32 {
-        let band = self.cos_theta[c.y as usize] - self.cos_theta[c.y as usize + 1];
-        let rows = (self.size.y - 1) as f32;
-        if band > 0.0 {
-            self.distribution.pdf(c) / (rows * TAU * band)
-        } else {
-            0.0
+        Patch {
+            x0,
+            x1: (x0 + 1) % w,
+            y0,
+            t: Vec2::new(fx - xf, fy - y0 as f32),
         }
     }
 
-    /// A light-space direction for the sample `u`, with its (u, v) and
+    /// The values of `table` (one per pixel) at the corners of `at`'s
+    /// cell, in [`bilinear`]'s order.
+    #[inline]
+    fn corners<T: Copy>(&self, table: &[T], at: &Patch) -> [T; 4] {
+        let w = self.size.x as usize;
+        let (top, bottom) = (at.y0 * w, (at.y0 + 1) * w);
+        [
+            table[top + at.x0],
+            table[top + at.x1],
+            table[bottom + at.x0],
+            table[bottom + at.x1],
+        ]
+    }
+
+    /// Radiance at `at`: bilinear between pixels.
+    #[inline]
+    fn radiance(&self, at: &Patch) -> Rgb {
+        let [a, b, c, d] = self.corners(&self.texels, at);
+        let t = at.t;
+        let top = a * (1.0 - t.x) + b * t.x;
+        let bottom = c * (1.0 - t.x) + d * t.x;
+        top * (1.0 - t.y) + bottom * t.y
+    }
+
+    /// Solid-angle density at `at`, where sin θ is `sin_theta`: the
+    /// cell's density over (u, v) times the bilinear patch's within it,
+    /// over 2π² sin θ.
+    #[inline]
+    fn pdf(&self, at: &Patch, sin_theta: f32) -> f32 {
+        if sin_theta <= 0.0 {
+            return 0.0;
+        }
+        let cell = UVec2::new(at.x0 as u32, at.y0 as u32);
+        let patch = bilinear_pdf(at.t, self.corners(&self.weights, at));
+        self.distribution.pdf(cell) * patch / (2.0 * PI * PI * sin_theta)
+    }
+
+    /// A light-space direction for the sample `u`, with its radiance and
     /// density.
     #[inline]
-    fn sample(&self, u: Vec2) -> (Vec3, f32, f32, f32) {
-        let (p, c) = self.distribution.sample(u);
-        let rows = (self.size.y - 1) as f32;
-        let fv = (p.y * rows - c.y as f32).clamp(0.0, 1.0);
-        let (z0, z1) = (
-            self.cos_theta[c.y as usize],
-            self.cos_theta[c.y as usize + 1],
-        );
-        let cos_t = (z0 + (z1 - z0) * fv).clamp(-1.0, 1.0);
-        let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+    fn sample(&self, u: Vec2) -> (Vec3, Rgb, f32) {
+        let d = &self.distribution;
+        let (y, ry) = d.marginal().sample(u.y);
+        let (x, rx) = d.rows()[y].sample(u.x);
+        let w = self.size.x as usize;
+        let mut at = Patch {
+            x0: x,
+            x1: (x + 1) % w,
+            y0: y,
+            t: Vec2::ZERO,
+        };
+        at.t = sample_bilinear(Vec2::new(rx, ry), self.corners(&self.weights, &at));
         // Cells start at the first pixel centre, half a pixel into the map.
-        let mut u = p.x + 0.5 / self.size.x as f32;
+        let mut u = (x as f32 + 0.5 + at.t.x) / w as f32;
         if u >= 1.0 {
             u -= 1.0;
         }
+        let v = (y as f32 + at.t.y) / (self.size.y - 1) as f32;
+        let (sin_t, cos_t) = (PI * v).sin_cos();
         let (sin_p, cos_p) = (TAU * u).sin_cos();
-        let d = Vec3::new(sin_p * sin_t, cos_t, -cos_p * sin_t);
-        (d, u, cos_t.acos() / PI, self.cell_pdf(c))
+        let dir = Vec3::new(sin_p * sin_t, cos_t, -cos_p * sin_t);
+        (dir, self.radiance(&at), self.pdf(&at, sin_t))
     }
 }
 
@@ -381,10 +459,7 @@ impl Light for EnvironmentLight {
         for ((r, u), o) in refs.iter().zip(u).zip(out.iter_mut()) {
             let (local, radiance, pdf) = match &self.emission {
                 Emission::Constant(c) => (square_to_uniform_sphere(*u), *c, UNIFORM_SPHERE_PDF),
-                Emission::Map(m) => {
-                    let (d, su, sv, pdf) = m.sample(*u);
-                    (d, m.lookup(su, sv), pdf)
-                }
+                Emission::Map(m) => m.sample(*u),
             };
             let wi = self.to_render * local;
             *o = LightSample {
@@ -446,10 +521,7 @@ impl radiant_core::Emission for EnvironmentLight {
         for ((up, ud), o) in u_pos.iter().zip(u_dir).zip(out.iter_mut()) {
             let (local, radiance, pdf_dir) = match &self.emission {
                 Emission::Constant(c) => (square_to_uniform_sphere(*ud), *c, UNIFORM_SPHERE_PDF),
-                Emission::Map(m) => {
-                    let (d, su, sv, pdf) = m.sample(*ud);
-                    (d, m.lookup(su, sv), pdf)
-                }
+                Emission::Map(m) => m.sample(*ud),
             };
             let dir = -(self.to_render * local);
             let (p, pdf_pos) = crate::emitted::disc_origin(&self.sphere, dir, *up);
@@ -636,7 +708,7 @@ mod tests {
                 .collect()
         };
         let (wu, rows) = (w as usize, h as usize - 1);
-        assert_eq!(table(2, h as usize), map.cos_theta);
+        assert_eq!(table(2, (w * h) as usize), map.weights);
         let marginal = table(3, rows + 1);
         let conditional = table(4, rows * (wu + 1));
         for y in 0..rows {

@@ -3,16 +3,10 @@
 // Parameters (offsets from p): 0 reach (2 × the scene sphere's radius),
 // 1..10 the light-to-render rotation's columns, 10 the kind (0 constant,
 // 1 map). A constant: 11..14 its radiance. A map: 11 width w, 12 height h,
-// 13..17 the offsets of its tables: cos θ per pixel row (h), the marginal
-// CDF over the h − 1 cell rows (h entries), the conditional CDF of each
-// cell row (w + 1 entries each), the texels (3 floats each, row-major,
-// zenith first); the tables follow from 17 on.
-
-// acos as precise as atan2 (some GPUs' acos is off by 1e-4), for x in
-// [−1, 1].
-fn env_acos(x: f32) -> f32 {
-    return atan2(sqrt(max((1.0 - x) * (1.0 + x), 0.0)), x);
-}
+// 13..17 the offsets of its tables: the sampling weight per pixel (w × h,
+// row-major), the marginal CDF over the h − 1 cell rows (h entries), the
+// conditional CDF of each cell row (w + 1 entries each), the texels (3
+// floats each, row-major, zenith first); the tables follow from 17 on.
 
 struct EnvCell {
     i: u32,
@@ -42,12 +36,52 @@ fn env_sample_1d(cdf: u32, n: u32, u: f32) -> EnvCell {
     return EnvCell(i, rest);
 }
 
-fn env_texel(p: u32, x: u32, y: u32) -> vec3f {
-    return param_vec3(p + param_u32(p + 16u) + 3u * (y * param_u32(p + 11u) + x));
+// bilinear.rs: sample_linear, a point of [0, 1) with density
+// ∝ (1 − x) a + x b.
+fn env_sample_linear(u: f32, a: f32, b: f32) -> f32 {
+    let sum = a + b;
+    if sum <= 0.0 {
+        return u;
+    }
+    let an = a / sum;
+    let bn = b / sum;
+    let den = an + sqrt((1.0 - u) * an * an + u * bn * bn);
+    if den > 0.0 {
+        return min(u / den, 0.99999994);
+    }
+    return 0.0;
 }
 
-// Map::lookup: bilinear between pixels, wrapping in u.
-fn env_lookup(p: u32, u: f32, v: f32) -> vec3f {
+// bilinear.rs: sample_bilinear; corners w.x at (0, 0), w.y at (1, 0),
+// w.z at (0, 1), w.w at (1, 1).
+fn env_sample_bilinear(u: vec2f, w: vec4f) -> vec2f {
+    let y = env_sample_linear(u.y, w.x + w.y, w.z + w.w);
+    let x = env_sample_linear(u.x, w.x + (w.z - w.x) * y, w.y + (w.w - w.y) * y);
+    return vec2f(x, y);
+}
+
+// bilinear.rs: bilinear_pdf.
+fn env_bilinear_pdf(t: vec2f, w: vec4f) -> f32 {
+    let sum = w.x + w.y + w.z + w.w;
+    if sum <= 0.0 {
+        return 1.0;
+    }
+    let top = w.x + (w.y - w.x) * t.x;
+    let bottom = w.z + (w.w - w.z) * t.x;
+    return 4.0 * (top + (bottom - top) * t.y) / sum;
+}
+
+// Map's Patch: a cell (between the centres of pixels x0 and x1, rows y0
+// and y0 + 1) and a place t within it.
+struct EnvPatch {
+    x0: u32,
+    x1: u32,
+    y0: u32,
+    t: vec2f,
+}
+
+// Map::locate: the cell of (u, v), as the radiance is interpolated.
+fn env_locate(p: u32, u: f32, v: f32) -> EnvPatch {
     let w = param_u32(p + 11u);
     let h = param_u32(p + 12u);
     let fx = u * f32(w) - 0.5;
@@ -56,29 +90,49 @@ fn env_lookup(p: u32, u: f32, v: f32) -> vec3f {
     let wi = i32(w);
     let x0 = u32(((i32(xf) % wi) + wi) % wi);
     let y0 = min(u32(max(fy, 0.0)), h - 2u);
-    let tx = fx - xf;
-    let ty = fy - f32(y0);
-    let x1 = (x0 + 1u) % w;
-    let top = env_texel(p, x0, y0) * (1.0 - tx) + env_texel(p, x1, y0) * tx;
-    let bottom = env_texel(p, x0, y0 + 1u) * (1.0 - tx) + env_texel(p, x1, y0 + 1u) * tx;
-    return top * (1.0 - ty) + bottom * ty;
+    return EnvPatch(x0, (x0 + 1u) % w, y0, vec2f(fx - xf, fy - f32(y0)));
 }
 
-// Map::cell_pdf: the solid-angle density of cell (x, y).
-fn env_cell_pdf(p: u32, x: u32, y: u32) -> f32 {
+fn env_texel(p: u32, x: u32, y: u32) -> vec3f {
+    return param_vec3(p + param_u32(p + 16u) + 3u * (y * param_u32(p + 11u) + x));
+}
+
+// Map::radiance: bilinear between pixels.
+fn env_radiance(p: u32, at: EnvPatch) -> vec3f {
+    let t = at.t;
+    let top = env_texel(p, at.x0, at.y0) * (1.0 - t.x) + env_texel(p, at.x1, at.y0) * t.x;
+    let bottom = env_texel(p, at.x0, at.y0 + 1u) * (1.0 - t.x) + env_texel(p, at.x1, at.y0 + 1u) * t.x;
+    return top * (1.0 - t.y) + bottom * t.y;
+}
+
+// Map::corners of the pixel weights.
+fn env_weights(p: u32, at: EnvPatch) -> vec4f {
     let w = param_u32(p + 11u);
-    let rows = param_u32(p + 12u) - 1u;
-    let cos_at = p + param_u32(p + 13u);
-    let band = param_f32(cos_at + y) - param_f32(cos_at + y + 1u);
-    if band <= 0.0 {
+    let weights = p + param_u32(p + 13u);
+    let top = weights + at.y0 * w;
+    let bottom = top + w;
+    return vec4f(
+        param_f32(top + at.x0),
+        param_f32(top + at.x1),
+        param_f32(bottom + at.x0),
+        param_f32(bottom + at.x1),
+    );
+}
+
+// Map::pdf: the solid-angle density at `at`, where sin θ is `sin_theta`.
+fn env_pdf(p: u32, at: EnvPatch, sin_theta: f32) -> f32 {
+    if sin_theta <= 0.0 {
         return 0.0;
     }
+    let w = param_u32(p + 11u);
+    let rows = param_u32(p + 12u) - 1u;
     let marginal = p + param_u32(p + 14u);
-    let row = p + param_u32(p + 15u) + y * (w + 1u);
-    let pdf = (param_f32(marginal + y + 1u) - param_f32(marginal + y))
-        * (param_f32(row + x + 1u) - param_f32(row + x))
+    let row = p + param_u32(p + 15u) + at.y0 * (w + 1u);
+    let cell = (param_f32(marginal + at.y0 + 1u) - param_f32(marginal + at.y0))
+        * (param_f32(row + at.x0 + 1u) - param_f32(row + at.x0))
         * f32(w * rows);
-    return pdf / (f32(rows) * (2.0 * PI) * band);
+    let within = env_bilinear_pdf(at.t, env_weights(p, at));
+    return cell * within / (2.0 * PI * PI * sin_theta);
 }
 
 // EnvironmentLight::eval_local: radiance from the light-space direction d
@@ -89,14 +143,12 @@ fn env_eval_local(p: u32, d: vec3f) -> EmitterEval {
     }
     var u = atan2(d.x, -d.z) / (2.0 * PI);
     u -= floor(u);
-    let v = env_acos(clamp(d.y, -1.0, 1.0)) / PI;
-    // Map::cell
-    let w = param_u32(p + 11u);
-    let h = param_u32(p + 12u);
-    let wi = i32(w);
-    let x = u32(((i32(floor(u * f32(w) - 0.5)) % wi) + wi) % wi);
-    let y = min(u32(max(v * f32(h - 1u), 0.0)), h - 2u);
-    return EmitterEval(env_lookup(p, u, v), env_cell_pdf(p, x, y));
+    // θ from atan2, not acos(y): exact near the poles too (and some
+    // GPUs' acos is off by 1e-4).
+    let sin_theta = sqrt(d.x * d.x + d.z * d.z);
+    let v = atan2(sin_theta, d.y) / PI;
+    let at = env_locate(p, u, v);
+    return EmitterEval(env_radiance(p, at), env_pdf(p, at, sin_theta));
 }
 
 fn light_sample_environment(p: u32, r: vec3f, u: vec2f) -> LightSample {
@@ -113,22 +165,20 @@ fn light_sample_environment(p: u32, r: vec3f, u: vec2f) -> LightSample {
         let rows = param_u32(p + 12u) - 1u;
         let cy = env_sample_1d(p + param_u32(p + 14u), rows, u.y);
         let cx = env_sample_1d(p + param_u32(p + 15u) + cy.i * (w + 1u), w, u.x);
-        let px = (f32(cx.i) + cx.rest) / f32(w);
-        let py = (f32(cy.i) + cy.rest) / f32(rows);
-        let fv = clamp(py * f32(rows) - f32(cy.i), 0.0, 1.0);
-        let cos_at = p + param_u32(p + 13u);
-        let z0 = param_f32(cos_at + cy.i);
-        let z1 = param_f32(cos_at + cy.i + 1u);
-        let cos_t = clamp(z0 + (z1 - z0) * fv, -1.0, 1.0);
-        let sin_t = sqrt(max(1.0 - cos_t * cos_t, 0.0));
-        var su = px + 0.5 / f32(w);
+        var at = EnvPatch(cx.i, (cx.i + 1u) % w, cy.i, vec2f(0.0));
+        at.t = env_sample_bilinear(vec2f(cx.rest, cy.rest), env_weights(p, at));
+        // Cells start at the first pixel centre, half a pixel into the map.
+        var su = (f32(cx.i) + 0.5 + at.t.x) / f32(w);
         if su >= 1.0 {
             su -= 1.0;
         }
+        let v = (f32(cy.i) + at.t.y) / f32(rows);
+        let sin_t = sin(PI * v);
+        let cos_t = cos(PI * v);
         let phi = 2.0 * PI * su;
         local = vec3f(sin(phi) * sin_t, cos_t, -cos(phi) * sin_t);
-        radiance = env_lookup(p, su, env_acos(cos_t) / PI);
-        pdf = env_cell_pdf(p, cx.i, cy.i);
+        radiance = env_radiance(p, at);
+        pdf = env_pdf(p, at, sin_t);
     }
     let to_render = mat3x3f(param_vec3(p + 1u), param_vec3(p + 4u), param_vec3(p + 7u));
     let wi = to_render * local;
