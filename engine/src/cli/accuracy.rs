@@ -34,8 +34,8 @@ pub struct AccuracyArgs {
     /// filter, filter_sampling, sampler, light_selection, bvh, backend (the
     /// GPU, where a hardware adapter is present), denoise (Open Image
     /// Denoise, where it loads), integrator (every registered integrator),
-    /// adaptive (adaptive sampling on or off); the scene as written is
-    /// always measured.
+    /// adaptive (adaptive sampling toward each error goal, relative and
+    /// mse, or off); the scene as written is always measured.
     #[arg(long, value_delimiter = ',')]
     only: Vec<String>,
     /// Largest samples per pixel of a setting.
