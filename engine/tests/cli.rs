@@ -792,6 +792,45 @@ fn a_band_larger_than_memory_is_a_clear_error() {
 }
 
 #[test]
+fn adaptive_decisions_larger_than_memory_are_a_clear_error() {
+    // Adaptive sampling toward the least MSE decides the whole frame first:
+    // 8192² pixels × 52 bytes is 3.25 GiB, more than a 1.2 GB address-space
+    // limit, where the band itself (as in the test above) fits.
+    let (dir, out) = temp("huge.exr");
+    let scene = dir.path().join("adaptive.yaml");
+    let text = TRIVIAL_SCENE.replace(
+        "sampler: {type: independent, spp: 1}",
+        "sampler: {type: independent, spp: 4, adaptive: {error: mse}}",
+    );
+    assert!(text.contains("error: mse"));
+    std::fs::write(&scene, text).expect("the scene is written");
+    let o = Command::new("prlimit")
+        .arg("--as=1200000000")
+        .arg(env!("CARGO_BIN_EXE_radiant"))
+        .arg("render")
+        .arg(&scene)
+        .args([
+            "--backend",
+            "cpu",
+            "--width",
+            "8192",
+            "--height",
+            "8192",
+            "-o",
+        ])
+        .arg(&out)
+        .output()
+        .expect("prlimit (util-linux) runs");
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("GiB for adaptive sampling's per-pixel decisions (error: mse)"),
+        "{err}"
+    );
+    assert!(!out.exists(), "no output may be left behind");
+}
+
+#[test]
 fn a_whole_film_larger_than_memory_is_a_clear_error() {
     // The accuracy report keeps whole films: 8192² pixels need 4.75 GiB
     // (64 bytes of exact sums and 12 of image a pixel), more than a 1.2 GB

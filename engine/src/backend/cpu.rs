@@ -433,15 +433,26 @@ pub fn render_rows(
     let mut tiler = Tiler::new(scene, tiles, None, 0..s.spp, progress);
     tiler.stop = Some(interrupt.flag);
     let bands = tiler.bands(group);
-    tiler.allocate_frame();
     let threads = rayon::current_num_threads();
     // A thread's first allocation makes glibc reserve it an arena of
     // address space (64 MiB); let every thread take its own before
     // measuring what is left, so that under an address-space limit the
     // check sees what the render will have.
     rayon::broadcast(|_| std::hint::black_box(Vec::<u8>::with_capacity(1)));
-    bands.need(threads).check()?;
-    let too_large = || RenderError::Memory(bands.need(threads));
+    let need = || {
+        let mut need = bands.need(threads);
+        if tiler.allocates() {
+            let pixels = u64::from(s.width) * u64::from(s.height);
+            need.parts.push((
+                "adaptive sampling's per-pixel decisions (error: mse)",
+                pixels * budget::DECISION_BYTES,
+            ));
+        }
+        need
+    };
+    need().check()?;
+    let too_large = || RenderError::Memory(need());
+    tiler.allocate_frame();
     let mut film = Film::try_band(s.width, s.height, bands.rows()).ok_or_else(too_large)?;
     let mut finished = Vec::new();
     finished
@@ -737,12 +748,27 @@ impl<'a> Tiler<'a> {
     /// frame's counts into `allocated` (once; before rendering, within the
     /// render's time), unless a pass before decided them.
     fn allocate_frame(&self) {
-        if let Some(a) = &self.scene.settings.adaptive
-            && a.error == ErrorGoal::Mse
-            && self.decided.is_none()
+        if let Some(a) = self
+            .scene
+            .settings
+            .adaptive
+            .as_ref()
+            .filter(|_| self.allocates())
         {
             self.allocated.get_or_init(|| self.frame_counts(a));
         }
+    }
+
+    /// Whether the render decides the whole frame's counts when it starts
+    /// ([`Tiler::allocate_frame`]): adaptive sampling toward the least MSE,
+    /// not decided by a pass before.
+    fn allocates(&self) -> bool {
+        self.decided.is_none()
+            && self
+                .scene
+                .settings
+                .adaptive
+                .is_some_and(|a| a.error == ErrorGoal::Mse)
     }
 
     /// `value(worker, tile)` of every tile (row-major in the tile), on the

@@ -35,6 +35,11 @@ use super::module::{Batch, batches};
 use crate::film::Reconstruction;
 use radiant_core::Rgb;
 
+/// Bytes a frame pixel's decisions take at their peak: its pilot (mean
+/// and σ) in its tile's results and in the frame, its effective σ before
+/// and after pooling, and its count.
+pub const DECISION_BYTES: u64 = 2 * 16 + 2 * 8 + 4;
+
 /// Pilot decision samples per pixel for a budget of `spp`: a
 /// [`DECISION_SHARE`]th of it, from 4 (a variance needs a few) to 64
 /// (enough for σ; more would only cost).
