@@ -58,6 +58,10 @@ pub struct Blas {
     order: Vec<u32>,
     /// See [`Blas::version`].
     version: u64,
+    /// Whether any packet holds spheres: queries of a level without them
+    /// are compiled without the sphere test, which frees the registers
+    /// that hold the ray for it.
+    spheres: bool,
 }
 
 /// The next [`Blas::version`].
@@ -65,6 +69,43 @@ static NEXT_VERSION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64
 
 fn next_version() -> u64 {
     NEXT_VERSION.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+/// A ray as a bottom level's queries take it: origin, direction, shutter
+/// time and its per-ray constants.
+struct Ray {
+    origin: Vec3,
+    dir: Vec3,
+    tau: f32,
+    prep: RayPrep,
+    boxes: RayBoxes,
+}
+
+impl Ray {
+    #[inline(always)]
+    fn new(origin: Vec3, dir: Vec3, tau: f32) -> Self {
+        Self {
+            origin,
+            dir,
+            tau,
+            prep: RayPrep::new(origin, dir),
+            boxes: RayBoxes::new(origin, dir),
+        }
+    }
+}
+
+/// `$blas.$method::<$isa, MOVING, SPHERES>(args)` with the flags that
+/// level `$blas` needs (whether it moves under the shutter, whether it
+/// holds spheres): each combination is its own compiled query.
+macro_rules! by_flags {
+    ($blas:ident, $method:ident::<$isa:ident>($($arg:expr),*)) => {
+        match ($blas.closing.is_some(), $blas.spheres) {
+            (false, false) => $blas.$method::<$isa, false, false>($($arg),*),
+            (false, true) => $blas.$method::<$isa, false, true>($($arg),*),
+            (true, false) => $blas.$method::<$isa, true, false>($($arg),*),
+            (true, true) => $blas.$method::<$isa, true, true>($($arg),*),
+        }
+    };
 }
 
 impl Blas {
@@ -93,6 +134,7 @@ impl Blas {
         self.closing = close.map(|close| closing(close, &order, &packets));
         self.packets = packets;
         self.order = order;
+        self.spheres = has_spheres(&self.packets);
         self.version = next_version();
     }
 
@@ -121,6 +163,7 @@ impl Blas {
         if update.rebuilt {
             self.order = order;
             self.packets = packets;
+            self.spheres = has_spheres(&self.packets);
         } else {
             // Same leaves, same order: repack the moved triangles.
             repack(&mut self.packets, prims, &self.order);
@@ -223,23 +266,46 @@ impl Blas {
         if self.packets.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return Hit::MISS;
         }
-        let prep = RayPrep::new(origin, dir);
-        let boxes = RayBoxes::new(origin, dir);
-        match &self.closing {
-            None => {
-                let mut query = Query::<false>::new(&self.packets, &[], 0.0, origin, dir, &prep);
-                query.base = base;
-                self.hierarchy.wide.closest::<I>(&boxes, tmax, &mut query);
-                query.best
-            }
-            Some(c) => {
-                let mut query =
-                    Query::<true>::new(&self.packets, &c.packets, tau, origin, dir, &prep);
-                query.base = base;
-                self.hierarchy.wide.closest::<I>(&boxes, tmax, &mut query);
-                query.best
-            }
-        }
+        let ray = Ray::new(origin, dir, tau);
+        by_flags!(self, closest_in::<I>(&ray, tmax, base))
+    }
+
+    /// [`Blas::closest`] with the query compiled for motion (`MOVING`) and
+    /// for spheres (`SPHERES`) as this level needs.
+    #[inline(always)]
+    fn closest_in<I: Isa, const MOVING: bool, const SPHERES: bool>(
+        &self,
+        ray: &Ray,
+        tmax: f32,
+        base: u32,
+    ) -> Hit {
+        let mut query = self.query::<MOVING, SPHERES>(ray);
+        query.base = base;
+        self.hierarchy
+            .wide
+            .closest::<I>(&ray.boxes, tmax, &mut query);
+        query.best
+    }
+
+    /// [`Blas::any`] as [`Blas::closest_in`].
+    #[inline(always)]
+    fn any_in<I: Isa, const MOVING: bool, const SPHERES: bool>(
+        &self,
+        ray: &Ray,
+        tmax: f32,
+    ) -> bool {
+        let mut query = self.query::<MOVING, SPHERES>(ray);
+        self.hierarchy.wide.any::<I>(&ray.boxes, tmax, &mut query)
+    }
+
+    /// A query of `ray` against this level's packets.
+    #[inline(always)]
+    fn query<'a, const MOVING: bool, const SPHERES: bool>(
+        &'a self,
+        ray: &'a Ray,
+    ) -> Query<'a, MOVING, SPHERES> {
+        let closing = self.closing.as_ref().map_or(&[][..], |c| &c.packets);
+        Query::new(&self.packets, closing, ray)
     }
 
     /// Whether anything blocks `origin + t·dir` for t in (0, `tmax`) at
@@ -249,20 +315,14 @@ impl Blas {
         if self.packets.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return false;
         }
-        let prep = RayPrep::new(origin, dir);
-        let boxes = RayBoxes::new(origin, dir);
-        match &self.closing {
-            None => {
-                let mut query = Query::<false>::new(&self.packets, &[], 0.0, origin, dir, &prep);
-                self.hierarchy.wide.any::<I>(&boxes, tmax, &mut query)
-            }
-            Some(c) => {
-                let mut query =
-                    Query::<true>::new(&self.packets, &c.packets, tau, origin, dir, &prep);
-                self.hierarchy.wide.any::<I>(&boxes, tmax, &mut query)
-            }
-        }
+        let ray = Ray::new(origin, dir, tau);
+        by_flags!(self, any_in::<I>(&ray, tmax))
     }
+}
+
+/// Whether any of `packets` holds spheres.
+fn has_spheres(packets: &[Packet]) -> bool {
+    packets.iter().any(|p| matches!(p, Packet::Spheres { .. }))
 }
 
 /// The boxes of `prims` (containing their shapes at shutter close too).
@@ -375,9 +435,12 @@ fn closing(close: &[Primitive], order: &[u32], open: &[Packet]) -> Closing {
 
 /// One ray's query at the leaves: its packets (and, where `MOVING`,
 /// their shapes at shutter close with the ray's time), its per-ray
-/// constants and the closest hit so far. The flag is a constant so that
-/// static geometry's loops carry no test for motion.
-struct Query<'a, const MOVING: bool> {
+/// constants and the closest hit so far. The flags are constants so that
+/// static geometry's loops carry no test for motion, and those of a level
+/// without spheres (`!SPHERES`) no sphere test: its packets are all
+/// triangles, and the ray's origin and direction, which only the sphere
+/// test reads, need no registers.
+struct Query<'a, const MOVING: bool, const SPHERES: bool> {
     packets: &'a [Packet],
     closing: &'a [Packet],
     tau: f32,
@@ -390,23 +453,16 @@ struct Query<'a, const MOVING: bool> {
     best: Hit,
 }
 
-impl<'a, const MOVING: bool> Query<'a, MOVING> {
+impl<'a, const MOVING: bool, const SPHERES: bool> Query<'a, MOVING, SPHERES> {
     #[inline(always)]
-    fn new(
-        packets: &'a [Packet],
-        closing: &'a [Packet],
-        tau: f32,
-        origin: Vec3,
-        dir: Vec3,
-        prep: &'a RayPrep,
-    ) -> Self {
+    fn new(packets: &'a [Packet], closing: &'a [Packet], ray: &'a Ray) -> Self {
         Self {
             packets,
             closing,
-            tau,
-            origin,
-            dir,
-            prep,
+            tau: ray.tau,
+            origin: ray.origin,
+            dir: ray.dir,
+            prep: &ray.prep,
             base: 0,
             best: Hit::MISS,
         }
@@ -425,7 +481,7 @@ impl<'a, const MOVING: bool> Query<'a, MOVING> {
     }
 }
 
-impl<const MOVING: bool> LeafVisitor for Query<'_, MOVING> {
+impl<const MOVING: bool, const SPHERES: bool> LeafVisitor for Query<'_, MOVING, SPHERES> {
     #[inline(always)]
     fn closest(&mut self, range: Range<usize>, mut tmax: f32) -> f32 {
         for i in range {
@@ -451,7 +507,7 @@ impl<const MOVING: bool> LeafVisitor for Query<'_, MOVING> {
                 }
                 Packet::Spheres {
                     ref spheres, first, ..
-                } => {
+                } if SPHERES => {
                     if let Some((lane, t)) = hit_spheres(spheres, self.origin, self.dir, tmax) {
                         tmax = t;
                         self.best = Hit {
@@ -463,6 +519,8 @@ impl<const MOVING: bool> LeafVisitor for Query<'_, MOVING> {
                         };
                     }
                 }
+                // A level without spheres has none.
+                Packet::Spheres { .. } => {}
             }
         }
         tmax
@@ -479,9 +537,11 @@ impl<const MOVING: bool> LeafVisitor for Query<'_, MOVING> {
                         tris.any(self.prep, tmax)
                     }
                 }
-                Packet::Spheres { ref spheres, .. } => {
+                Packet::Spheres { ref spheres, .. } if SPHERES => {
                     any_sphere(spheres, self.origin, self.dir, tmax)
                 }
+                // A level without spheres has none.
+                Packet::Spheres { .. } => false,
             };
             if hit {
                 return true;
