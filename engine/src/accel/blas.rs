@@ -83,12 +83,12 @@ struct Ray {
 
 impl Ray {
     #[inline(always)]
-    fn new(origin: Vec3, dir: Vec3, tau: f32) -> Self {
+    fn new<I: Isa>(origin: Vec3, dir: Vec3, tau: f32) -> Self {
         Self {
             origin,
             dir,
             tau,
-            prep: RayPrep::new(origin, dir),
+            prep: RayPrep::new_with::<I>(origin, dir),
             boxes: RayBoxes::new(origin, dir),
         }
     }
@@ -266,7 +266,7 @@ impl Blas {
         if self.packets.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return Hit::MISS;
         }
-        let ray = Ray::new(origin, dir, tau);
+        let ray = Ray::new::<I>(origin, dir, tau);
         by_flags!(self, closest_in::<I>(&ray, tmax, base))
     }
 
@@ -315,7 +315,7 @@ impl Blas {
         if self.packets.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return false;
         }
-        let ray = Ray::new(origin, dir, tau);
+        let ray = Ray::new::<I>(origin, dir, tau);
         by_flags!(self, any_in::<I>(&ray, tmax))
     }
 }

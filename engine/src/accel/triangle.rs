@@ -10,6 +10,7 @@
 //! watertightness carries over. The ray's axis permutation only selects
 //! which coordinate arrays are loaded, so it costs nothing.
 
+use super::wide::Isa;
 use glam::{BVec4A, DVec3, Vec3, Vec3A, Vec4};
 
 /// Per-ray constants of the watertight test.
@@ -27,17 +28,63 @@ pub struct RayPrep {
 /// [`RayPrep::axes`] by dominant axis.
 const AXES: [[usize; 3]; 3] = [[1, 2, 0], [2, 0, 1], [0, 1, 2]];
 
+/// Which of [`AXES`] is the ray's: the dominant axis of `dir` (the last
+/// of equal ones but the first), chosen without branches: random
+/// directions would mispredict them.
+#[inline(always)]
+fn axes_index(dir: Vec3) -> usize {
+    let a = dir.abs();
+    let x_gt_y = a.x > a.y;
+    let is_x = x_gt_y & (a.x > a.z);
+    let is_y = !x_gt_y & (a.y > a.z);
+    2 - 2 * usize::from(is_x) - usize::from(is_y)
+}
+
+/// [`AXES`] as the lane selectors of a permutation (VPERMILPS), the
+/// fourth lane kept.
+#[cfg(target_arch = "x86_64")]
+const PERMUTE: [[i32; 4]; 3] = [[1, 2, 0, 3], [2, 0, 1, 3], [0, 1, 2, 3]];
+
 impl RayPrep {
+    /// [`RayPrep::new`] with the instruction set `I`: with AVX2 the
+    /// origin and direction are permuted in registers rather than through
+    /// memory (the same values).
+    #[inline(always)]
+    pub fn new_with<I: Isa>(origin: Vec3, dir: Vec3) -> Self {
+        #[cfg(target_arch = "x86_64")]
+        if I::AVX2 {
+            // SAFETY: `Avx2` traversals run only on CPUs with AVX2 (`Isa`).
+            return unsafe { Self::new_avx(origin, dir) };
+        }
+        Self::new(origin, dir)
+    }
+
+    /// [`RayPrep::new`] by lane permutations: the origin and direction
+    /// permuted by the ray's [`PERMUTE`] entry, the shear constants
+    /// `(−dx, −dy, 1) / dz` in one division as there.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn new_avx(origin: Vec3, dir: Vec3) -> Self {
+        use std::arch::x86_64::*;
+        let k = axes_index(dir);
+        // SAFETY: a `PERMUTE` entry is four i32, 16 bytes.
+        let select = unsafe { _mm_loadu_si128(PERMUTE[k].as_ptr().cast()) };
+        let o = _mm_permutevar_ps(Vec3A::from(origin).into(), select);
+        let d = _mm_permutevar_ps(Vec3A::from(dir).into(), select);
+        let dz = _mm_permute_ps::<0b10_10_10_10>(d);
+        let numerator = _mm_blend_ps::<0b0100>(_mm_xor_ps(d, _mm_set1_ps(-0.0)), _mm_set1_ps(1.0));
+        Self {
+            origin: Vec3A::from(o).to_array(),
+            shear: Vec3A::from(_mm_div_ps(numerator, dz)).to_array(),
+            axes: AXES[k],
+        }
+    }
+
     /// Prepares the ray `origin + t·dir`.
     #[inline(always)]
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        let a = dir.abs();
-        // The dominant axis (the last of equal ones but the first), chosen
-        // without branches: random directions would mispredict them.
-        let x_gt_y = a.x > a.y;
-        let is_x = x_gt_y & (a.x > a.z);
-        let is_y = !x_gt_y & (a.y > a.z);
-        let axes = AXES[2 - 2 * usize::from(is_x) - usize::from(is_y)];
+        let axes = AXES[axes_index(dir)];
         // Rotate the axes so that kz comes last: xyz, yzx or zxy (the
         // entries are below 3; `min` lets the compiler see it).
         let [kx, ky, kz] = axes.map(|k| k.min(2));
@@ -305,6 +352,42 @@ mod tests {
         assert!(intersect(&miss, &tri, f32::INFINITY).is_none());
         let behind = RayPrep::new(Vec3::new(0.25, 0.25, 1.0), Vec3::Z);
         assert!(intersect(&behind, &tri, f32::INFINITY).is_none());
+    }
+
+    /// The AVX2 preparation against the portable one, bit for bit, on
+    /// random directions and on directions with equal, zero and negative
+    /// components (the dominant axis's ties).
+    #[test]
+    fn prepared_rays_are_the_same_with_avx2() {
+        #[cfg(target_arch = "x86_64")]
+        if super::super::wide::Avx2::detected() {
+            let mut s = 7u32;
+            let mut r = || {
+                s = s.wrapping_mul(1664525).wrapping_add(1013904223);
+                (s >> 8) as f32 / (1 << 24) as f32 - 0.5
+            };
+            let mut dirs: Vec<Vec3> = (0..5000).map(|_| Vec3::new(r(), r(), r())).collect();
+            for a in [-1.0, 0.0, 0.5, 1.0] {
+                for b in [-1.0, 0.0, 0.5, 1.0] {
+                    for c in [-1.0, 0.0, 1.0] {
+                        dirs.push(Vec3::new(a, b, c));
+                    }
+                }
+            }
+            for d in dirs {
+                let o = Vec3::new(r(), r(), r()) * 10.0;
+                let want = RayPrep::new(o, d);
+                // SAFETY: the CPU supports AVX2.
+                let got = unsafe { RayPrep::new_avx(o, d) };
+                assert_eq!(got.axes, want.axes, "{d}");
+                assert_eq!(got.origin.map(f32::to_bits), want.origin.map(f32::to_bits));
+                assert_eq!(
+                    got.shear.map(f32::to_bits),
+                    want.shear.map(f32::to_bits),
+                    "{d}"
+                );
+            }
+        }
     }
 
     #[test]
