@@ -371,14 +371,20 @@ pub struct RayBoxes {
     /// direction is positive), and of those it meets last. Offsets rather
     /// than side indices, so that a node test loads them without
     /// recomputing addresses.
-    near: [u32; 3],
-    far: [u32; 3],
+    ///
+    /// Both are read from their [`OFFSETS`] entry, which the ray refers
+    /// to rather than copies (a ray entering a hierarchy then writes six
+    /// fewer words).
+    offsets: &'static Offsets,
 }
 
-/// [`RayBoxes::near`] and [`RayBoxes::far`] by the signs of the
-/// direction's components (bit `axis` set where it is negative): a table,
-/// so that each ray entering a hierarchy copies them rather than computes.
-const OFFSETS: [([u32; 3], [u32; 3]); 8] = {
+/// [`RayBoxes`]' byte offsets: (near, far) per axis.
+type Offsets = ([u32; 3], [u32; 3]);
+
+/// [`RayBoxes::offsets`] by the signs of the direction's components (bit
+/// `axis` set where it is negative): a table, so that each ray entering a
+/// hierarchy refers to them rather than computes.
+static OFFSETS: [Offsets; 8] = {
     let mut table = [([0; 3], [0; 3]); 8];
     let mut signs = 0;
     while signs < 8 {
@@ -413,17 +419,16 @@ impl RayBoxes {
     /// per component), where the caller has it already.
     #[inline(always)]
     pub fn from_inverse(origin: Vec3, inv_dir: Vec3A) -> Self {
-        let (near, far) = OFFSETS[inv_dir.cmplt(Vec3A::ZERO).bitmask() as usize & 7];
+        let offsets = &OFFSETS[inv_dir.cmplt(Vec3A::ZERO).bitmask() as usize & 7];
         Self {
             origin: origin.to_array(),
             inv_dir: inv_dir.to_array(),
-            near,
-            far,
+            offsets,
         }
     }
 
     /// Four lanes of `node`'s bounds at byte `offset` (one of
-    /// [`RayBoxes::near`] or [`RayBoxes::far`]) plus group `g`.
+    /// [`RayBoxes::offsets`]) plus group `g`.
     #[inline(always)]
     fn lanes(node: &Node, offset: u32, g: usize) -> Vec4 {
         // SAFETY: `offset` is side · SIDE_BYTES + axis · AXIS_BYTES with
@@ -467,8 +472,8 @@ impl RayBoxes {
             // (`RayBoxes::lanes`): eight contiguous f32 in a 64-byte
             // aligned node, at a multiple of 32 bytes (an aligned load).
             let bounds = |offset: u32| unsafe { _mm256_load_ps(bytes.add(offset as usize).cast()) };
-            let lo = _mm256_mul_ps(_mm256_sub_ps(bounds(self.near[axis]), origin), inv_dir);
-            let hi = _mm256_mul_ps(_mm256_sub_ps(bounds(self.far[axis]), origin), inv_dir);
+            let lo = _mm256_mul_ps(_mm256_sub_ps(bounds(self.offsets.0[axis]), origin), inv_dir);
+            let hi = _mm256_mul_ps(_mm256_sub_ps(bounds(self.offsets.1[axis]), origin), inv_dir);
             // MAXPS/MINPS keep the second operand where the first is NaN,
             // as `max_of` and `min_of` do.
             t_near = _mm256_max_ps(lo, t_near);
@@ -495,8 +500,8 @@ impl RayBoxes {
                     Vec4::splat(self.origin[axis]),
                     Vec4::splat(self.inv_dir[axis]),
                 );
-                let lo = (Self::lanes(node, self.near[axis], g) - origin) * inv_dir;
-                let hi = (Self::lanes(node, self.far[axis], g) - origin) * inv_dir;
+                let lo = (Self::lanes(node, self.offsets.0[axis], g) - origin) * inv_dir;
+                let hi = (Self::lanes(node, self.offsets.1[axis], g) - origin) * inv_dir;
                 t_near = max_of(lo, t_near);
                 t_far = min_of(hi, t_far);
             }
