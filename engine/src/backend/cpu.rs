@@ -681,8 +681,8 @@ impl<'a> Tiler<'a> {
             };
             let spp = self.scene.settings.spp;
             let share = |c| adaptive::pass_share(&self.samples, spp, c);
-            tile.set_pixel_scales(counts.iter().map(|&c| 1.0 / c.max(1) as f32).collect());
-            adaptive::render_image(&counts, rect, share, |batch| {
+            adaptive::render_image(&counts, rect, share, |batch, count| {
+                tile.set_scale(1.0 / count as f32);
                 let out = TileOutput {
                     film: &mut tile,
                     aovs: aovs.as_deref_mut(),
@@ -690,7 +690,7 @@ impl<'a> Tiler<'a> {
                 };
                 worker.render(&ctx, batch, out);
             });
-            tile.set_pixel_scales(Vec::new());
+            tile.set_scale(1.0);
             let traced = counts.iter().map(|&c| share(c).len() as u64).sum();
             self.finish_tile(rect, &counts, traced);
             return (tile, worker.rays() - rays_before);

@@ -207,18 +207,11 @@ pub struct TileFilm {
     sums: Vec<Sums>,
     /// Samples whose value was NaN or infinite (recorded as zero).
     pub invalid_samples: u64,
-    /// The weight of the sample added next, value and filter weight both
-    /// (1 unless per-pixel scales are set): under adaptive sampling 1 / the
-    /// samples its pixel takes, so that every pixel weighs as much in a
-    /// splat neighbourhood however many samples it took.
+    /// The weight of the samples added next, value and filter weight both
+    /// (1 unless set): under adaptive sampling 1 / the samples their pixel
+    /// takes, so that every pixel weighs as much in a splat neighbourhood
+    /// however many samples it took.
     scale: f32,
-    /// Where set, the weight of each of the tile's own pixels' samples
-    /// instead of `scale` (row-major over `own`): under adaptive sampling,
-    /// where one batch holds pixels of different counts.
-    pixel_scales: Vec<f32>,
-    /// The tile's own pixels, [x0, x1) × [y0, y1), which `pixel_scales`
-    /// covers.
-    own: (u32, u32, u32, u32),
 }
 
 impl TileFilm {
@@ -232,48 +225,12 @@ impl TileFilm {
             sums: vec![Sums::ZERO; bounds.len()],
             invalid_samples: 0,
             scale: 1.0,
-            pixel_scales: Vec::new(),
-            own: (x0, y0, x1, y1),
         }
     }
 
-    /// Weighs the samples of each of the tile's own pixels added from now
-    /// on by its entry of `scales` (row-major over the tile's pixels), or,
-    /// where `scales` is empty, by 1 again.
-    pub fn set_pixel_scales(&mut self, scales: Vec<f32>) {
-        let (x0, y0, x1, y1) = self.own;
-        debug_assert!(scales.is_empty() || scales.len() == ((x1 - x0) * (y1 - y0)) as usize);
-        self.pixel_scales = scales;
-        self.scale = 1.0;
-    }
-
-    /// Sets the scale for the samples of frame pixel `pixel` (index in the
-    /// frame, row-major) where per-pixel scales are set.
-    #[inline]
-    fn scale_for(&mut self, pixel: u32) {
-        if !self.pixel_scales.is_empty() {
-            let width = self.bounds.image_width as u32;
-            let (x0, y0, x1, _) = self.own;
-            let (x, y) = (pixel % width, pixel / width);
-            self.scale = self.pixel_scales[((y - y0) * (x1 - x0) + x - x0) as usize];
-        }
-    }
-
-    /// [`TileFilm::splat`] for a sample of frame pixel `pixel` (row-major
-    /// index), weighted by that pixel's scale where per-pixel scales are set.
-    #[inline]
-    pub fn splat_sample(&mut self, pixel: u32, pos: Vec2, value: Rgb, table: &FilterTable) {
-        self.scale_for(pixel);
-        self.splat(pos, value, table);
-    }
-
-    /// [`TileFilm::add`] for a sample of frame pixel `pixel` (row-major
-    /// index), weighted by that pixel's scale where per-pixel scales are set.
-    #[inline]
-    pub fn add_sample(&mut self, pixel: u32, value: Rgb, weight: f32) {
-        self.scale_for(pixel);
-        let width = self.bounds.image_width as u32;
-        self.add(pixel % width, pixel / width, value, weight);
+    /// Weighs the samples added from now on by `scale` (see the field).
+    pub fn set_scale(&mut self, scale: f32) {
+        self.scale = scale;
     }
 
     /// Adds row `y` of this tile (its own row index) to `row`, the film's

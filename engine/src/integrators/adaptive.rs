@@ -395,16 +395,16 @@ pub fn decide(
 
 /// Renders the image samples of tile `t` whose pixels take `counts`
 /// samples (from [`decide`]): of a pixel taking `c`, the sample indices
-/// `samples(c)`, by `render(batch)` for the runs of pixels of each count
-/// in turn. (Rendering each count's pixels on their own keeps the film's
-/// blocks of sample indices the same in passes as in one render, see
-/// [`pass_share`]; a splatting film weighs each pixel's samples by 1 / its
-/// count, see `backend/cpu.rs`.)
+/// `samples(c)`. `render(batch, c)` renders a batch whose pixels all take
+/// `c` (a splatting film weights their samples by 1/`c`, see
+/// `backend/cpu.rs`). Rendering each count's pixels on their own keeps the
+/// film's blocks of sample indices the same in passes as in one render
+/// (see [`pass_share`]).
 pub fn render_image(
     counts: &[u32],
     t: TileRect,
     samples: impl Fn(u32) -> std::ops::Range<u32>,
-    mut render: impl FnMut(Batch),
+    mut render: impl FnMut(Batch, u32),
 ) {
     let mut classes = counts.to_vec();
     classes.sort_unstable();
@@ -418,7 +418,7 @@ pub fn render_image(
         for (m, &n) in members.iter_mut().zip(counts) {
             *m = n == c;
         }
-        for_runs(&members, t, range, &mut render);
+        for_runs(&members, t, range, &mut |b| render(b, c));
     }
 }
 

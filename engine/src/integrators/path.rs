@@ -284,14 +284,19 @@ impl Wavefront {
             match reconstruction {
                 Reconstruction::Splat(table) => {
                     for i in slots {
-                        let pixel = self.ids[i].pixel;
-                        tile.splat_sample(pixel, self.film[i], self.radiance[i], table);
+                        tile.splat(self.film[i], self.radiance[i], table);
                     }
                 }
                 Reconstruction::Importance(_) => {
+                    let width = scene.settings.width;
                     for i in slots {
                         let pixel = self.ids[i].pixel;
-                        tile.add_sample(pixel, self.radiance[i], self.filter_weight[i]);
+                        tile.add(
+                            pixel % width,
+                            pixel / width,
+                            self.radiance[i],
+                            self.filter_weight[i],
+                        );
                     }
                 }
             }

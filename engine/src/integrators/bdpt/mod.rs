@@ -439,13 +439,16 @@ impl TileWorker for Worker {
         for (first, index) in (0..count).zip(batch.first_sample..) {
             for i in (first..n).step_by(count) {
                 match ctx.reconstruction {
-                    Reconstruction::Splat(table) => {
-                        let pixel = self.ids[i].pixel;
-                        out.film.splat_sample(pixel, self.film[i], values[i], table);
-                    }
+                    Reconstruction::Splat(table) => out.film.splat(self.film[i], values[i], table),
                     Reconstruction::Importance(_) => {
+                        let width = scene.settings.width;
                         let pixel = self.ids[i].pixel;
-                        out.film.add_sample(pixel, values[i], self.filter_weight[i]);
+                        out.film.add(
+                            pixel % width,
+                            pixel / width,
+                            values[i],
+                            self.filter_weight[i],
+                        );
                     }
                 }
             }
