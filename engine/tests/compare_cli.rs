@@ -111,3 +111,39 @@ fn compare_refuses_what_it_cannot_read() {
     assert!(stderr(&o).contains("must end in .png"), "{}", stderr(&o));
     assert!(!dir.path().join("diff.bmp").exists());
 }
+
+#[test]
+fn compare_into_a_closed_pipe_is_not_a_panic() {
+    // `radiant compare a b | head -1`: the reader is gone before the
+    // report is written (its end of the pipe is closed at once, while the
+    // images are still being read), which must end quietly with status 0.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/cornell-box.yaml");
+    let o = radiant(
+        dir.path(),
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            "a.exr",
+            "--width",
+            "256",
+            "--height",
+            "256",
+            "--spp",
+            "1",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut child = Command::new(env!("CARGO_BIN_EXE_radiant"))
+        .args(["compare", "a.exr", "a.exr"])
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("radiant runs");
+    drop(child.stdout.take());
+    let o = child.wait_with_output().expect("radiant ends");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
+}

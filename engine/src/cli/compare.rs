@@ -59,15 +59,21 @@ pub fn run(args: &CompareArgs) -> miette::Result<()> {
             b.height
         )
     })?;
-    println!("rmse {:.6}", c.rmse);
-    println!("relative_mse {:.6}", c.relative_mse);
+    let mut report = format!("rmse {:.6}\nrelative_mse {:.6}\n", c.rmse, c.relative_mse);
     if c.mean_ratio.is_finite() {
-        println!("mean_ratio {:.6}", c.mean_ratio);
+        report += &format!("mean_ratio {:.6}\n", c.mean_ratio);
     } else {
-        println!("mean_ratio undefined (the reference's mean is 0)");
+        report += "mean_ratio undefined (the reference's mean is 0)\n";
     }
     let map = radiant::accuracy::metrics::flip_map(&a, &b);
-    println!("flip {:.6}", radiant::accuracy::metrics::mean_flip(&map));
+    report += &format!("flip {:.6}\n", radiant::accuracy::metrics::mean_flip(&map));
+    // A reader that stops early (`| head -1`) is not an error.
+    match std::io::Write::write_all(&mut std::io::stdout().lock(), report.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            miette::bail!("cannot write the comparison to standard output: {e}")
+        }
+        _ => {}
+    }
     if let Some(diff) = &args.diff {
         write_heat_map(diff, &map).map_err(|e| miette::miette!("{e}"))?;
         eprintln!("wrote the FLIP error map to {}", diff.display());
