@@ -518,3 +518,132 @@ fn output_variables_are_the_camera_rays_first_hits() {
     assert_eq!(p.normal, b.normal);
     assert_eq!(p.depth, b.depth);
 }
+
+/// `scene` (its text edited by `edit`) rendered by `integrator` with
+/// per-strategy images at (spp, size², depth): the image and the
+/// strategies' images by name.
+fn render_strategies(
+    scene: &str,
+    integrator: &str,
+    edit: impl FnOnce(String) -> String,
+    (spp, size, depth): (u32, u32, i32),
+) -> (Image, Vec<(String, Image)>) {
+    let path = root().join(scene);
+    let text = edit(with_integrator(
+        &std::fs::read_to_string(&path).unwrap(),
+        integrator,
+    ));
+    let loaded =
+        radiant::scene::from_str(&text, std::path::Path::new(scene), path.parent().unwrap())
+            .unwrap();
+    let overrides = Overrides {
+        spp: Some(spp),
+        seed: Some(11),
+        width: Some(size),
+        height: Some(size),
+        max_depth: Some(depth),
+        ..Default::default()
+    };
+    let r = extract(&loaded, &radiant::builtin_registry(), &overrides).unwrap();
+    let progress = radiant::backend::cpu::Progress::none();
+    let (rendered, images) = radiant::backend::cpu::try_render_strategies(&r, &progress)
+        .unwrap()
+        .expect("bdpt has strategies");
+    assert_eq!(rendered.invalid_samples, 0, "{scene}: invalid samples");
+    (rendered.image, images)
+}
+
+/// The largest |Σ strategies − image| over pixels and channels.
+fn sum_error(image: &Image, strategies: &[(String, Image)]) -> f32 {
+    (0..image.pixels.len())
+        .flat_map(|p| (0..3).map(move |c| (p, c)))
+        .map(|(p, c)| {
+            let sum: f32 = strategies.iter().map(|(_, s)| s.pixels[p][c]).sum();
+            (sum - image.pixels[p][c]).abs()
+        })
+        .fold(0.0, f32::max)
+}
+
+#[test]
+fn strategy_images_sum_to_the_image() {
+    // With a box filter, the image's Σ w·L / Σ w is the plain mean of each
+    // pixel's samples, as the strategy images' splats are: the strategies
+    // (every contribution in exactly one of them, weighted) sum to the
+    // image up to rounding. The Cornell box has every kind (emitter hits,
+    // next-event estimation, connections, light paths on the lens), the
+    // environment scene escaped paths. Mutation check (by hand): leaving
+    // out the log of any one of the six kinds of contribution in
+    // `integrators/bdpt` fails this test.
+    let boxed = |text: String| {
+        let mut out = String::new();
+        let mut skip = false;
+        for line in text.lines() {
+            if line.trim_start().starts_with("filter:") {
+                out += "  filter: {type: box}\n";
+                skip = !line.contains('{');
+                continue;
+            }
+            if skip && line.starts_with("    ") {
+                continue;
+            }
+            skip = false;
+            out += line;
+            out.push('\n');
+        }
+        out
+    };
+    for scene in ["scenes/cornell-box.yaml", "scenes/environment.yaml"] {
+        let (image, strategies) = render_strategies(scene, "{type: bdpt}", boxed, (16, 16, 4));
+        // k + 1 strategies of each length k ≤ 4.
+        assert_eq!(strategies.len(), 2 + 3 + 4 + 5, "{scene}");
+        let brightest = image
+            .pixels
+            .iter()
+            .map(|p| p.max_element())
+            .fold(0.0, f32::max);
+        let error = sum_error(&image, &strategies);
+        eprintln!("{scene}: Σ strategies − image at most {error:e} (brightest {brightest})");
+        assert!(error <= 1e-5 * brightest, "{scene}: {error}");
+        let mean = |name: &str| {
+            let (_, s) = strategies.iter().find(|(n, _)| n == name).unwrap();
+            s.pixels.iter().map(|p| p.x + p.y + p.z).sum::<f32>()
+        };
+        // Each kind carries light: (0, 2) emitter or sky seen, (1, 2)
+        // next-event, (2, 2) a connection, (2, 1) a light path on the lens.
+        for name in ["s0_t2", "s1_t2", "s2_t2", "s2_t1"] {
+            assert!(mean(name) > 0.0, "{scene}: {name} is black");
+        }
+    }
+}
+
+#[test]
+fn each_strategy_image_holds_its_own_strategy() {
+    // With `strategy: [s, t]`, one strategy makes the whole image: its
+    // image must be the image, every other one black (the strategy
+    // images are indexed as they are named).
+    for (s, t) in [(0usize, 3usize), (1, 2), (2, 2), (3, 1), (1, 1)] {
+        let integrator = format!("{{type: bdpt, strategy: [{s}, {t}]}}");
+        let (image, strategies) =
+            render_strategies("scenes/cornell-box.yaml", &integrator, |t| t, (32, 8, 3));
+        let own = format!("s{s}_t{t}");
+        for (name, strategy) in &strategies {
+            let light: f32 = strategy.pixels.iter().map(|p| p.x + p.y + p.z).sum();
+            if *name == own {
+                assert!(light > 0.0, "{own}: its own image is black");
+            } else {
+                assert_eq!(light, 0.0, "{own}: {name} is not black");
+            }
+        }
+        if t > 1 {
+            // Camera-side strategies land in their own pixels (the
+            // Gaussian filter spreads both alike).
+            let own_image = &strategies.iter().find(|(n, _)| *n == own).unwrap().1;
+            let total: f32 = image.pixels.iter().map(|p| p.x + p.y + p.z).sum();
+            let split: f32 = own_image.pixels.iter().map(|p| p.x + p.y + p.z).sum();
+            assert!(
+                (split / total - 1.0).abs() < 0.02,
+                "{own}: {split} against the image's {total}"
+            );
+        }
+    }
+}

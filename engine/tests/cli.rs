@@ -858,3 +858,108 @@ fn a_whole_film_larger_than_memory_is_a_clear_error() {
     );
     assert!(err.contains("rows at this width"), "{err}");
 }
+
+/// `scenes/hard/caustic.yaml` rendered by `bdpt`, written into `dir`.
+fn bdpt_caustic(dir: &Path) -> PathBuf {
+    let scene = dir.join("caustic.yaml");
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/hard/caustic.yaml"),
+    )
+    .unwrap()
+    .replace(
+        "integrator: {type: path, max_depth: 8}",
+        "integrator: {type: bdpt}",
+    );
+    assert!(text.contains("type: bdpt"));
+    std::fs::write(&scene, text).unwrap();
+    scene
+}
+
+#[test]
+fn strategies_writes_one_image_per_bdpt_strategy() {
+    let (dir, out) = temp("caustic.exr");
+    let strategies = dir.path().join("by-strategy");
+    let scene = bdpt_caustic(dir.path());
+    let o = radiant(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--spp",
+        "4",
+        "--max-depth",
+        "3",
+        "--strategies",
+        strategies.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.exists());
+    // Paths of 1, 2 and 3 segments: 2 + 3 + 4 strategies.
+    let mut names: Vec<String> = std::fs::read_dir(&strategies)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "s0_t2", "s0_t3", "s0_t4", "s1_t1", "s1_t2", "s1_t3", "s2_t1", "s2_t2", "s3_t1"
+        ]
+        .map(|n| format!("{n}.exr")),
+        "{}",
+        stderr(&o)
+    );
+    assert!(
+        stderr(&o).contains("9 per-strategy images"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn strategies_refuses_what_it_cannot_split() {
+    let (dir, out) = temp("out.exr");
+    let strategies = dir.path().join("by-strategy");
+    let caustic = bdpt_caustic(dir.path());
+    let caustic = caustic.to_str().unwrap();
+    let cases: [(&[&str], &str); 4] = [
+        (&["scenes/cornell-box.yaml"], "the scene's `path` has none"),
+        (
+            &[caustic, "--max-depth", "-1"],
+            "--strategies needs a finite max_depth",
+        ),
+        (
+            &["scenes/cornell-box.yaml", "--backend", "gpu"],
+            "--strategies cannot be combined with --backend gpu",
+        ),
+        (
+            &["scenes/cornell-box.yaml", "--spp-map", "map.png"],
+            "--strategies cannot be combined with --spp-map",
+        ),
+    ];
+    for (args, message) in cases {
+        let mut all = vec!["render"];
+        all.extend_from_slice(args);
+        all.extend_from_slice(&[
+            "-o",
+            out.to_str().unwrap(),
+            "--spp",
+            "1",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--strategies",
+            strategies.to_str().unwrap(),
+        ]);
+        let o = radiant(&all);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(message), "{args:?}: {err}");
+        assert!(!out.exists(), "{args:?}: no output may be left behind");
+        assert!(
+            std::fs::read_dir(&strategies).map_or(true, |mut d| d.next().is_none()),
+            "{args:?}: no strategy image may be left behind"
+        );
+    }
+}

@@ -24,6 +24,7 @@ use crate::film::{Film, Image, Reconstruction, TileFilm};
 use crate::integrators::adaptive::{self, ErrorGoal, TileRect};
 use crate::integrators::budget::{self, Pilot};
 use crate::integrators::module::batches;
+use crate::integrators::strategies::{StrategyFilms, StrategyImages};
 use crate::integrators::{
     Batch, ChainContext, Family, SplatFilm, TileContext, TileIntegrator, TileOutput, TileWorker,
 };
@@ -81,7 +82,7 @@ pub fn try_render(scene: &RenderScene, progress: &Progress<'_>) -> Result<Render
             });
         }
     };
-    Ok(render_tiles(scene, tiles, progress, false)?.0)
+    Ok(render_tiles(scene, tiles, progress, false, None)?.0)
 }
 
 /// Renders `scene` as [`try_render`] does (the same image) and also
@@ -93,24 +94,49 @@ pub fn try_render_counted(
     progress: &Progress<'_>,
 ) -> Result<(Rendered, Option<Vec<u32>>), FrameTooLarge> {
     match scene.integrator.family() {
-        Family::Tiles(tiles) => render_tiles(scene, tiles, progress, true),
+        Family::Tiles(tiles) => render_tiles(scene, tiles, progress, true, None),
         Family::Chains(_) => Ok((try_render(scene, progress)?, None)),
     }
 }
 
+/// Renders `scene` as [`try_render`] does (the same image) and also its
+/// per-strategy images ([`crate::integrators::strategies`]), by name;
+/// `None` where its integrator names no strategies (then nothing is
+/// rendered).
+pub fn try_render_strategies(
+    scene: &RenderScene,
+    progress: &Progress<'_>,
+) -> Result<Option<(Rendered, StrategyImages)>, FrameTooLarge> {
+    let Family::Tiles(tiles) = scene.integrator.family() else {
+        return Ok(None);
+    };
+    let names = tiles.strategies(scene);
+    if names.is_empty() {
+        return Ok(None);
+    }
+    let s = &scene.settings;
+    let films = StrategyFilms::new(names, s.width, s.height, scene.filter.as_ref())?;
+    let (rendered, _) = render_tiles(scene, tiles, progress, false, Some(&films))?;
+    let images = films.develop(s.width, s.height, rendered.samples)?;
+    Ok(Some((rendered, images)))
+}
+
 /// Renders all samples of `scene` with the tile integrator `tiles` into a
 /// whole film (and splat film), counting each pixel's samples where
-/// `count`.
+/// `count` and splitting contributions by strategy into `strategies` where
+/// given.
 fn render_tiles(
     scene: &RenderScene,
     tiles: &dyn TileIntegrator,
     progress: &Progress<'_>,
     count: bool,
+    strategies: Option<&StrategyFilms>,
 ) -> Result<(Rendered, Option<Vec<u32>>), FrameTooLarge> {
     let s = &scene.settings;
     let mut film = Film::try_new(s.width, s.height)?;
     let splats = frame_splats(scene, tiles)?;
     let mut tiler = Tiler::new(scene, tiles, splats.as_ref(), 0..s.spp, progress);
+    tiler.strategies = strategies;
     if count {
         let counts = crate::film::memory::try_filled(s.width as usize * s.height as usize, 0u32)
             .ok_or_else(|| FrameTooLarge::new(s.width, s.height))?;
@@ -506,6 +532,8 @@ struct Tiler<'a> {
     integrator: &'a dyn TileIntegrator,
     /// The frame's splat film, where the integrator splats.
     splats: Option<&'a SplatFilm>,
+    /// The per-strategy films, where the render asks for them.
+    strategies: Option<&'a StrategyFilms>,
     /// Where adaptive sampling's decision samples splat (dropped): made
     /// once per frame, for a splatting integrator under adaptive sampling.
     decision_sink: Option<SplatFilm>,
@@ -549,6 +577,7 @@ impl<'a> Tiler<'a> {
             scene,
             integrator,
             splats,
+            strategies: None,
             decision_sink: splats
                 .filter(|_| s.adaptive.is_some())
                 .map(|_| SplatFilm::sink(scene.filter.as_ref())),
@@ -826,8 +855,10 @@ impl<'a> Tiler<'a> {
         let s = &self.scene.settings;
         let reach = self.reconstruction.reach();
         let mut scratch = TileFilm::new(t.x0, t.y0, t.x1, t.y1, (s.width, s.height), reach);
+        // Decision samples never reach the image, nor its strategies'.
         let ctx = TileContext {
             splats: self.decision_sink.as_ref(),
+            strategies: None,
             ..self.context()
         };
         decide(&mut |batch, add| {
@@ -873,6 +904,7 @@ impl<'a> Tiler<'a> {
             scene: self.scene,
             reconstruction: &self.reconstruction,
             splats: self.splats,
+            strategies: self.strategies,
         }
     }
 }

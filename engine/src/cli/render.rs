@@ -6,6 +6,7 @@ mod partition;
 mod passes;
 mod progressive;
 mod spp_map;
+mod strategies;
 
 use super::diagnostic::report;
 use super::film_args::FilmArgs;
@@ -91,6 +92,14 @@ pub struct RenderArgs {
     /// number, as in `--output`. Renders on the CPU.
     #[arg(long, value_name = "MAP.png")]
     spp_map: Option<PathBuf>,
+    /// Also write one linear EXR per sampling strategy of the integrator
+    /// into this folder (`bdpt`: `s{s}_t{t}.exr` for s light and t camera
+    /// vertices, every path length up to `max_depth`), each holding that
+    /// strategy's MIS-weighted contributions: Veach's per-strategy images,
+    /// which sum to the image. A run of `#` is the frame number, as in
+    /// `--output`. Renders on the CPU.
+    #[arg(long, value_name = "DIR")]
+    strategies: Option<PathBuf>,
 }
 
 impl RenderArgs {
@@ -114,6 +123,23 @@ impl RenderArgs {
             });
         }
         self
+    }
+}
+
+/// What among `args` (and the planes a render records, `planes`) keeps
+/// an option that needs one whole CPU render of the image alone
+/// (`--spp-map`, `--strategies`) from working, if anything.
+fn whole_cpu_render_conflict(args: &RenderArgs, planes: bool) -> Option<&'static str> {
+    if args.backend == BackendKind::Gpu {
+        Some("--backend gpu")
+    } else if args.progressive.is_set() {
+        Some("--time, --checkpoint or --resume")
+    } else if args.partition.is_some() {
+        Some("--partition")
+    } else if planes {
+        Some("output variables, --denoise or alpha")
+    } else {
+        None
     }
 }
 
@@ -319,12 +345,16 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         // Alpha is the coverage plane, which the passes record.
         let planes = args.passes.wanted(settings) || settings.output.alpha;
         spp_map::check(args, planes)?;
+        strategies::check(args, planes)?;
         let session = progressive.as_ref().filter(|p| p.takes(s, planes));
         let rendered = pool.install(|| {
             let progress = Progress::new(&progress);
             if let Some(map) = &args.spp_map {
                 let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
                 spp_map::write(s, &path, &frame_path(map, frame), &progress, &note)
+            } else if let Some(dir) = &args.strategies {
+                let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
+                strategies::write(s, &path, &frame_path(dir, frame), &progress, &note)
             } else if let Some(session) = session {
                 let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
                 session.render(args, backend.as_mut(), (s, frame), &path, &progress, &note)

@@ -8,7 +8,8 @@
 //! [`module`] makes integrators a module kind (`integrator: {type: …}`,
 //! registered in the [`Registry`](radiant_core::Registry)) with a driver
 //! per family — image tiles, Markov chains — and [`splat`] is the
-//! whole-image film that light paths and chains splat into; [`adaptive`]
+//! whole-image film that light paths and chains splat into ([`strategies`]:
+//! one such film per sampling strategy, for per-strategy images); [`adaptive`]
 //! stops sampling converged pixels in the tile driver, and [`budget`]
 //! spreads a fixed budget of samples where they lower the mean squared
 //! error most.
@@ -22,6 +23,7 @@ pub mod module;
 pub mod path;
 mod sort;
 pub mod splat;
+pub mod strategies;
 pub mod surface;
 
 pub use module::{

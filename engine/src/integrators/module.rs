@@ -63,6 +63,7 @@
 pub use super::path::Batch;
 use super::path::Wavefront;
 use super::splat::SplatFilm;
+use super::strategies::StrategyFilms;
 use crate::backend::Progress;
 use crate::extract::RenderScene;
 use crate::film::aov::AovTile;
@@ -111,6 +112,14 @@ pub trait TileIntegrator: Send + Sync {
     /// A worker for one thread: the integrator's scratch, reused for every
     /// batch that thread renders (so nothing is allocated per ray).
     fn worker(&self) -> Box<dyn TileWorker + '_>;
+
+    /// The names of its sampling strategies in `scene`, one image each
+    /// where a render asks for per-strategy images
+    /// ([`super::strategies`]; `bdpt`: `s{s}_t{t}`); empty (the default)
+    /// where it splits its image by none.
+    fn strategies(&self, _scene: &RenderScene) -> Vec<String> {
+        Vec::new()
+    }
 }
 
 /// What every batch of a frame shares.
@@ -122,6 +131,10 @@ pub struct TileContext<'a> {
     /// The whole-image splat target, where the integrator
     /// [`splats`](TileIntegrator::splats).
     pub splats: Option<&'a SplatFilm>,
+    /// One film per [strategy](TileIntegrator::strategies), where the
+    /// render asks for per-strategy images: every contribution, weighted,
+    /// also goes to its strategy's film.
+    pub strategies: Option<&'a StrategyFilms>,
 }
 
 /// Where one batch's results go.

@@ -4,7 +4,7 @@
 //! (`sampler: {adaptive: …}`) spent its samples.
 
 use super::RenderArgs;
-use radiant::backend::{BackendKind, Progress, Written, cpu};
+use radiant::backend::{Progress, Written, cpu};
 use radiant::extract::RenderScene;
 use radiant::integrators::module::Family;
 use std::path::Path;
@@ -15,22 +15,12 @@ pub(super) fn check(args: &RenderArgs, planes: bool) -> miette::Result<()> {
     if args.spp_map.is_none() {
         return Ok(());
     }
-    let refuse = |what: &str| {
-        miette::bail!("--spp-map cannot be combined with {what}: it counts one whole CPU render")
-    };
-    if args.backend == BackendKind::Gpu {
-        return refuse("--backend gpu");
+    match super::whole_cpu_render_conflict(args, planes) {
+        Some(what) => miette::bail!(
+            "--spp-map cannot be combined with {what}: it counts one whole CPU render"
+        ),
+        None => Ok(()),
     }
-    if args.progressive.is_set() {
-        return refuse("--time, --checkpoint or --resume");
-    }
-    if args.partition.is_some() {
-        return refuse("--partition");
-    }
-    if planes {
-        return refuse("output variables, --denoise or alpha");
-    }
-    Ok(())
 }
 
 /// Renders `scene` counting samples per pixel, writes the image to `path`

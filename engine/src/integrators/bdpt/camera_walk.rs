@@ -169,6 +169,7 @@ impl State {
                 let value = self.beta[j] * e.radiance;
                 if emission.is_none() {
                     self.values[r] += value;
+                    self.log.add(j, 0, i + 1, value);
                     continue;
                 }
                 let em = self.emission_pdfs[r];
@@ -187,6 +188,7 @@ impl State {
                 let sum = side_sum(m, Side::Camera, i, l_fwd, rev_prev);
                 let w = self.strategy(0, i + 1, weight(sum, 0.0, 1.0));
                 self.values[r] += value * w;
+                self.log.add(j, 0, i + 1, value * w);
             }
         }
         for (&j, v) in self.req.iter().zip(&self.values) {
@@ -250,6 +252,7 @@ impl State {
                 let value = v.beta * e.radiance;
                 if light.emission().is_none() {
                     self.radiance[j] += value;
+                    self.log.add(j, 0, i + 1, value);
                     continue;
                 }
                 let em = self.emission_pdfs[p];
@@ -263,6 +266,7 @@ impl State {
                 m[i].eps = saved;
                 let w = self.strategy(0, i + 1, weight(sum, 0.0, 1.0));
                 self.radiance[j] += value * w;
+                self.log.add(j, 0, i + 1, value * w);
             }
         }
     }

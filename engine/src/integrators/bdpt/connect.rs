@@ -170,6 +170,7 @@ impl State {
             if s != u32::MAX && !self.shadows.blocked[s as usize] {
                 let r = self.by_light.order[self.kept[q] as usize] as usize;
                 self.radiance[self.req[r] as usize] += *v;
+                self.log.add(self.req[r] as usize, 1, i + 1, *v);
             }
         }
     }
@@ -295,6 +296,8 @@ impl State {
                 let s = self.shadow_of[c];
                 if s != u32::MAX && !self.shadows.blocked[s as usize] {
                     total += self.values[c];
+                    let k = self.call[c] as usize;
+                    self.log.add(j as usize, k + 1, i + 1, self.values[c]);
                 }
                 c += 1;
             }

@@ -13,11 +13,12 @@ use super::mis::{self, Mis, Side, ratio2, side_sum, weight};
 use super::shading::Op;
 use super::vertex::{Kind, Vertex};
 use super::walk::{Which, fit};
-use super::{CAMERA_DIMS, Start, State, dims};
+use super::{CAMERA_DIMS, Start, State, dims, strategy_index};
 use crate::accel::Hit;
 use crate::accel::offset::{offset_origin, sampled_point_error};
 use crate::extract::RenderScene;
 use crate::integrators::splat::SplatFilm;
+use crate::integrators::strategies::StrategyFilms;
 use glam::Vec3;
 use radiant_core::{EmissionKind, EmissionSample, EmitterHit, Rgb, ShadeContext};
 
@@ -29,6 +30,7 @@ impl State {
         scene: &RenderScene,
         shade: &mut ShadeContext<'_>,
         splats: Option<&SplatFilm>,
+        strategies: Option<&StrategyFilms>,
     ) {
         let n = self.ids.len();
         let max = self.max;
@@ -38,7 +40,7 @@ impl State {
             return;
         }
         self.start_lights(scene);
-        self.connect_lens(scene, shade, splats, 0);
+        self.connect_lens(scene, shade, (splats, strategies), 0);
         for k in 1..max {
             if self.live.is_empty() {
                 break;
@@ -48,7 +50,7 @@ impl State {
             if k == 1 {
                 self.next_event_ratios(scene);
             }
-            self.connect_lens(scene, shade, splats, k);
+            self.connect_lens(scene, shade, (splats, strategies), k);
             if k + 1 >= max {
                 break;
             }
@@ -283,7 +285,7 @@ impl State {
         &mut self,
         scene: &RenderScene,
         shade: &mut ShadeContext<'_>,
-        splats: Option<&SplatFilm>,
+        (splats, strategies): (Option<&SplatFilm>, Option<&StrategyFilms>),
         k: usize,
     ) {
         let Some(splats) = splats else { return };
@@ -398,7 +400,11 @@ impl State {
         self.rays += self.shadows.trace(scene);
         for (q, &r) in self.kept.iter().enumerate() {
             if !self.shadows.blocked[q] {
-                splats.splat(self.lens[r as usize].raster, self.values[q]);
+                let raster = self.lens[r as usize].raster;
+                splats.splat(raster, self.values[q]);
+                if let Some(films) = strategies {
+                    films.splat(strategy_index(k + 1, 1), raster, self.values[q]);
+                }
             }
         }
     }

@@ -62,12 +62,15 @@ mod light_walk;
 mod mis;
 mod shading;
 mod shadow;
+mod strategy_log;
 mod vertex;
 mod walk;
 
 use self::by_light::ByLight;
 use self::shading::{Op, Queue};
 use self::shadow::Shadows;
+use self::strategy_log::strategy_index;
+use self::strategy_log::{StrategyLog, strategy_names};
 use self::vertex::Subpaths;
 use super::module::{
     Batch, Family, Integrator, TileContext, TileIntegrator, TileOutput, TileWorker,
@@ -197,6 +200,12 @@ impl TileIntegrator for Bdpt {
         true
     }
 
+    /// Every (s, t) that `max_depth` allows, by path length (`s0_t2`,
+    /// `s1_t1`, `s0_t3`, …): Veach's per-strategy images.
+    fn strategies(&self, scene: &RenderScene) -> Vec<String> {
+        strategy_names(depth_limit(scene) as usize)
+    }
+
     fn worker(&self) -> Box<dyn TileWorker + '_> {
         Box::new(Worker {
             state: State {
@@ -233,7 +242,8 @@ const DOCS: &[ParamDoc] = &[
         default: "none (all, weighted)",
         doc: "Render one strategy alone, unweighted: s light vertices, t ≥ 1 camera vertices — \
               its image is the contribution of paths of s + t − 1 segments that this \
-              strategy can make (Veach's per-strategy images). For validation.",
+              strategy can make. For validation; `radiant render --strategies DIR` writes \
+              every strategy's weighted image in one render.",
     },
     ParamDoc {
         name: "connections",
@@ -394,6 +404,9 @@ pub(super) struct State {
     camera_pdfs: Vec<CameraRayPdf>,
     queue: Queue,
     shadows: Shadows,
+    /// The camera-side contributions by strategy, where per-strategy
+    /// images are asked for.
+    log: StrategyLog,
     rays: u64,
 }
 
@@ -420,16 +433,23 @@ impl TileWorker for Worker {
         }
         let state = &mut self.state;
         state.max = depth_limit(scene) as usize;
+        state.log.on = ctx.strategies.is_some();
         let chunk = (CHUNK_VERTICES / (state.max + 1)).max(16);
         for a in (0..n).step_by(chunk) {
             let b = n.min(a + chunk);
             state.ids.clear();
             state.ids.extend_from_slice(&self.ids[a..b]);
-            state.trace_lights(scene, &mut shade, ctx.splats);
+            state.trace_lights(scene, &mut shade, ctx.splats, ctx.strategies);
             state.fill_cache();
             let rays = (&self.origin[a..b], &self.dir[a..b], &self.weight[a..b]);
+            state.log.entries.clear();
             state.trace_cameras(scene, &mut shade, rays);
             self.values[a..b].copy_from_slice(&state.radiance[..b - a]);
+            if let Some(films) = ctx.strategies {
+                for &(j, index, v) in &state.log.entries {
+                    films.splat(index as usize, self.film[a + j as usize], v);
+                }
+            }
             if out.aovs.is_some() {
                 let first = &mut self.first_hits[a..b];
                 state.first_hits(scene, &mut shade, &self.origin[a..b], first);
