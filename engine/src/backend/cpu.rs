@@ -24,7 +24,7 @@ use crate::film::{Film, Image, Reconstruction, TileFilm};
 use crate::integrators::adaptive::{self, ErrorGoal, TileRect};
 use crate::integrators::budget::{self, Pilot};
 use crate::integrators::module::batches;
-use crate::integrators::strategies::{StrategyFilms, StrategyImages};
+use crate::integrators::strategies::{self, StrategiesError, StrategyFilms, StrategyImages};
 use crate::integrators::{
     Batch, ChainContext, Family, SplatFilm, TileContext, TileIntegrator, TileOutput, TileWorker,
 };
@@ -100,25 +100,19 @@ pub fn try_render_counted(
 }
 
 /// Renders `scene` as [`try_render`] does (the same image) and also its
-/// per-strategy images ([`crate::integrators::strategies`]), by name;
-/// `None` where its integrator names no strategies (then nothing is
-/// rendered).
+/// per-strategy images ([`crate::integrators::strategies`]), by name; or
+/// says, before anything renders, why its frame cannot be split by
+/// strategy or does not fit in memory.
 pub fn try_render_strategies(
     scene: &RenderScene,
     progress: &Progress<'_>,
-) -> Result<Option<(Rendered, StrategyImages)>, FrameTooLarge> {
-    let Family::Tiles(tiles) = scene.integrator.family() else {
-        return Ok(None);
-    };
-    let names = tiles.strategies(scene);
-    if names.is_empty() {
-        return Ok(None);
-    }
-    let s = &scene.settings;
-    let films = StrategyFilms::new(names, s.width, s.height, scene.filter.as_ref())?;
+) -> Result<(Rendered, StrategyImages), StrategiesError> {
+    let (tiles, names) = strategies::tile_strategies(scene)?;
+    let films = StrategyFilms::new(names, scene)?;
     let (rendered, _) = render_tiles(scene, tiles, progress, false, Some(&films))?;
+    let s = &scene.settings;
     let images = films.develop(s.width, s.height, rendered.samples)?;
-    Ok(Some((rendered, images)))
+    Ok((rendered, images))
 }
 
 /// Renders all samples of `scene` with the tile integrator `tiles` into a

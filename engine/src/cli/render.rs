@@ -7,6 +7,7 @@ mod passes;
 mod progressive;
 mod spp_map;
 mod strategies;
+mod whole_cpu;
 
 use super::diagnostic::report;
 use super::film_args::FilmArgs;
@@ -126,23 +127,6 @@ impl RenderArgs {
     }
 }
 
-/// What among `args` (and the planes a render records, `planes`) keeps
-/// an option that needs one whole CPU render of the image alone
-/// (`--spp-map`, `--strategies`) from working, if anything.
-fn whole_cpu_render_conflict(args: &RenderArgs, planes: bool) -> Option<&'static str> {
-    if args.backend == BackendKind::Gpu {
-        Some("--backend gpu")
-    } else if args.progressive.is_set() {
-        Some("--time, --checkpoint or --resume")
-    } else if args.partition.is_some() {
-        Some("--partition")
-    } else if planes {
-        Some("output variables, --denoise or alpha")
-    } else {
-        None
-    }
-}
-
 /// Parses `A..B` or `N`.
 pub fn parse_frames(text: &str) -> Result<(i64, i64), String> {
     let number = |s: &str| {
@@ -237,6 +221,7 @@ struct Totals {
 pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
     // The flags alone first, before the scene is read; then with its keys.
     passes::check(args, &radiant::settings::RenderSettings::default())?;
+    whole_cpu::check_flags(args)?;
     if let Some(p) = args.partition {
         return partition::run(registry, args, p);
     }
@@ -302,8 +287,9 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
             Some(b) => b,
             None => backend.insert(
                 choose(
-                    // First-hit planes are recorded on the CPU.
-                    if args.passes.wanted(settings) {
+                    // First-hit planes, sample counts and strategies are
+                    // recorded on the CPU.
+                    if args.passes.wanted(settings) || whole_cpu::asked(args).is_some() {
                         BackendKind::Cpu
                     } else {
                         args.backend
@@ -344,8 +330,7 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
         }
         // Alpha is the coverage plane, which the passes record.
         let planes = args.passes.wanted(settings) || settings.output.alpha;
-        spp_map::check(args, planes)?;
-        strategies::check(args, planes)?;
+        whole_cpu::check_planes(args, planes)?;
         let session = progressive.as_ref().filter(|p| p.takes(s, planes));
         let rendered = pool.install(|| {
             let progress = Progress::new(&progress);

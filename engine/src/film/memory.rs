@@ -87,7 +87,9 @@ impl FrameTooLarge {
     fn what_fits(&self, available: u64) -> String {
         match self.band {
             None => {
-                let rows = available / (self.width as u64 * (SUM_BYTES + IMAGE_BYTES)).max(1);
+                // Every part is per pixel: rows scale the whole need.
+                let rows = (available as u128 * self.height as u128 / self.needed().max(1) as u128)
+                    .min(u64::MAX as u128);
                 format!("enough for {rows} rows at this width")
             }
             Some(_) => {

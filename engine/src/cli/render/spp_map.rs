@@ -3,25 +3,10 @@
 //! heat map of the counts — where adaptive sampling
 //! (`sampler: {adaptive: …}`) spent its samples.
 
-use super::RenderArgs;
 use radiant::backend::{Progress, Written, cpu};
 use radiant::extract::RenderScene;
 use radiant::integrators::module::Family;
 use std::path::Path;
-
-/// Checks, before anything renders, that the map can be made as asked:
-/// on the CPU, in one whole render of the image alone.
-pub(super) fn check(args: &RenderArgs, planes: bool) -> miette::Result<()> {
-    if args.spp_map.is_none() {
-        return Ok(());
-    }
-    match super::whole_cpu_render_conflict(args, planes) {
-        Some(what) => miette::bail!(
-            "--spp-map cannot be combined with {what}: it counts one whole CPU render"
-        ),
-        None => Ok(()),
-    }
-}
 
 /// Renders `scene` counting samples per pixel, writes the image to `path`
 /// and the heat map to `map` (both atomically), and says on stderr how

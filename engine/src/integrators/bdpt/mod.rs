@@ -33,6 +33,12 @@
 //! and their predecessors by index. A sample's strategies are summed in
 //! the order the one-path-at-a-time walk added them.
 //!
+//! Where a render asks for per-strategy images
+//! ([`crate::integrators::strategies`]), each contribution, weighted, also
+//! goes to its strategy's film: the camera-side ones through the chunk's
+//! log (`strategy_log.rs`), splatted at their samples' film positions
+//! after the chunk, the t = 1 ones where they land.
+//!
 //! Each contribution is weighted by the power heuristic over all the
 //! strategies that could have made its path ([`mis`]). Vertices whose
 //! scattering is a delta lobe are never connected; delta lights (point,
@@ -447,7 +453,11 @@ impl TileWorker for Worker {
             self.values[a..b].copy_from_slice(&state.radiance[..b - a]);
             if let Some(films) = ctx.strategies {
                 for &(j, index, v) in &state.log.entries {
-                    films.splat(index as usize, self.film[a + j as usize], v);
+                    let i = a + j as usize;
+                    // The film records a sample that is not finite as black.
+                    if self.values[i].is_finite() {
+                        films.splat(index as usize, self.film[i], v);
+                    }
                 }
             }
             if out.aovs.is_some() {

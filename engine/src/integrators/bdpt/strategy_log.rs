@@ -6,8 +6,10 @@
 //! connections) are summed into its radiance where the walk finds them;
 //! where per-strategy images are asked for, each is also logged here with
 //! its sample slot and strategy, and the worker splats the log at the
-//! samples' film positions once the chunk is walked. The t = 1 strategies
-//! land away from their sample and are splatted where they land.
+//! samples' film positions once the chunk is walked (leaving out samples
+//! whose sum is not finite, which the image records as black). The t = 1
+//! strategies land away from their sample and are splatted where they
+//! land.
 
 use radiant_core::Rgb;
 
@@ -39,10 +41,12 @@ pub(super) struct StrategyLog {
 }
 
 impl StrategyLog {
-    /// Logs slot `j`'s contribution `value` (weighted) by strategy (s, t).
+    /// Logs slot `j`'s contribution `value` (weighted) by strategy (s, t),
+    /// unless it is zero (a weight of 0, or another strategy than the one
+    /// `strategy: [s, t]` renders).
     #[inline]
     pub(super) fn add(&mut self, j: usize, s: usize, t: usize, value: Rgb) {
-        if self.on {
+        if self.on && value != Rgb::ZERO {
             self.entries
                 .push((j as u32, strategy_index(s, t) as u32, value));
         }
