@@ -778,7 +778,7 @@ impl WideBvh {
                     current = node.child[lane] as usize;
                     continue;
                 }
-            } else {
+            } else if inner != 0 {
                 stack.push::<I>(node, inner, &t_near, true);
             }
             // Next: the nearest pending node that is not beyond the hit.
