@@ -750,6 +750,18 @@ impl WideBvh {
         self.nodes.is_empty()
     }
 
+    /// Node `index`, which must be 0 (the root of a non-empty tree) or a
+    /// node's child: unchecked, since [`WideBvh::build`] writes only the
+    /// indices of nodes it created into `child` (and refits keep them),
+    /// and a bounds check would hold a register through the traversal.
+    #[inline(always)]
+    fn node(&self, index: usize) -> &Node {
+        debug_assert!(index < self.nodes.len());
+        // SAFETY: see above; traversals start at the root only where
+        // `nodes` is not empty.
+        unsafe { self.nodes.get_unchecked(index) }
+    }
+
     /// Visits the leaves that `ray` may hit in (0, `tmax`), inner nodes
     /// nearest first, with [`LeafVisitor::closest`]; boxes beyond the
     /// closest hit so far are skipped.
@@ -761,7 +773,7 @@ impl WideBvh {
         let mut stack = Stack::new();
         let mut current = 0;
         loop {
-            let node = &self.nodes[current];
+            let node = self.node(current);
             let (mask, t_near) = ray.test::<I>(node, tmax);
             // Leaves nearest first, until the next one starts beyond the hit.
             let leaf_lanes = node.leaves();
@@ -814,7 +826,7 @@ impl WideBvh {
         let mut stack = Stack::new();
         let mut current = 0;
         loop {
-            let node = &self.nodes[current];
+            let node = self.node(current);
             let (mask, t_near) = ray.test::<I>(node, tmax);
             let leaf_lanes = node.leaves();
             let mut leaves = mask & leaf_lanes;
