@@ -266,8 +266,7 @@ impl Blas {
         if self.packets.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return Hit::MISS;
         }
-        let ray = Ray::new::<I>(origin, dir, tau);
-        by_flags!(self, closest_in::<I>(&ray, tmax, base))
+        by_flags!(self, closest_in::<I>(origin, dir, tau, tmax, base))
     }
 
     /// [`Blas::closest`] with the query compiled for motion (`MOVING`) and
@@ -275,10 +274,15 @@ impl Blas {
     #[inline(always)]
     fn closest_in<I: Isa, const MOVING: bool, const SPHERES: bool>(
         &self,
-        ray: &Ray,
+        origin: Vec3,
+        dir: Vec3,
+        tau: f32,
         tmax: f32,
         base: u32,
     ) -> Hit {
+        // Prepared here, in each combination of flags, so that one that
+        // does not read the ray's origin, direction or time stores none.
+        let ray = &Ray::new::<I>(origin, dir, tau);
         let mut query = self.query::<MOVING, SPHERES>(ray);
         query.base = base;
         self.hierarchy
@@ -291,9 +295,12 @@ impl Blas {
     #[inline(always)]
     fn any_in<I: Isa, const MOVING: bool, const SPHERES: bool>(
         &self,
-        ray: &Ray,
+        origin: Vec3,
+        dir: Vec3,
+        tau: f32,
         tmax: f32,
     ) -> bool {
+        let ray = &Ray::new::<I>(origin, dir, tau);
         let mut query = self.query::<MOVING, SPHERES>(ray);
         self.hierarchy.wide.any::<I>(&ray.boxes, tmax, &mut query)
     }
@@ -315,8 +322,7 @@ impl Blas {
         if self.packets.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return false;
         }
-        let ray = Ray::new::<I>(origin, dir, tau);
-        by_flags!(self, any_in::<I>(&ray, tmax))
+        by_flags!(self, any_in::<I>(origin, dir, tau, tmax))
     }
 }
 

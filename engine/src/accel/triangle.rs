@@ -210,15 +210,29 @@ impl Tri4 {
     /// The watertight test on all four lanes.
     #[inline(always)]
     fn test(&self, ray: &RayPrep, tmax: f32) -> Lanes {
-        // In range by construction; `min` lets the compiler see it.
-        let [kx, ky, kz] = ray.axes.map(|k| k.min(2));
-        let [ox, oy, oz] = ray.origin.map(Vec4::splat);
-        let [sx, sy, sz] = ray.shear.map(Vec4::splat);
+        // The ray's constants are read from memory at each packet
+        // (volatile reads, which the compiler may not hoist): held in
+        // registers through the whole traversal, as it otherwise does,
+        // they crowd out the box test's constants.
+        // SAFETY: reads of the ray's own fields.
+        let (axes, origin, shear) = unsafe {
+            let v = |x: &f32| std::ptr::read_volatile(x);
+            (
+                ray.axes.each_ref().map(|k| std::ptr::read_volatile(k)),
+                ray.origin.each_ref().map(v),
+                ray.shear.each_ref().map(v),
+            )
+        };
+        let [ox, oy, oz] = origin.map(Vec4::splat);
+        let [sx, sy, sz] = shear.map(Vec4::splat);
         // Translate to the ray origin, permute so the ray runs along +z,
         // and shear x and y (pbrt-v4 §6.5.3); z is scaled further below.
         let transform = |p: &[Vec4; 3]| {
-            let z = p[kz] - oz;
-            (p[kx] - ox + sx * z, p[ky] - oy + sy * z, z)
+            // SAFETY: `axes` is an entry of `AXES`, whose indices are
+            // below 3.
+            let [x, y, z] = axes.map(|k| unsafe { *p.get_unchecked(k) });
+            let z = z - oz;
+            (x - ox + sx * z, y - oy + sy * z, z)
         };
         let (x0, y0, z0) = transform(&self.v[0]);
         let (x1, y1, z1) = transform(&self.v[1]);

@@ -218,6 +218,8 @@ impl Stack {
     /// Pushes the children of `node` in `lanes` (a bit per lane), with
     /// their entry distances `t`; with `sorted`, so that the entries pushed
     /// are in order of decreasing distance (the nearest is popped first).
+    /// Without `sorted` the distances may be left unwritten (shadow rays
+    /// never read them): pop those entries with [`Self::pop_node`].
     #[inline(always)]
     fn push<I: Isa>(&mut self, node: &Node, lanes: u32, t: &[f32; WIDTH], sorted: bool) {
         #[cfg(target_arch = "x86_64")]
@@ -278,7 +280,6 @@ impl Stack {
             _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(PACK[lanes as usize & 0xff] as i64))
         };
         let nodes = _mm256_permutevar8x32_epi32(child, order);
-        let ts = _mm256_permutevar8x32_ps(t, order);
         // Panics rather than overflowing; `MAX_DEPTH` rules that out.
         let (nodes_at, ts_at) = (
             self.nodes[self.len..self.len + WIDTH].as_mut_ptr(),
@@ -287,7 +288,9 @@ impl Stack {
         // SAFETY: both point at eight slots of the stack (checked above).
         unsafe {
             _mm256_storeu_si256(nodes_at.cast(), nodes);
-            _mm256_storeu_ps(ts_at.cast(), ts);
+            if sorted {
+                _mm256_storeu_ps(ts_at.cast(), _mm256_permutevar8x32_ps(t, order));
+            }
         }
         self.len += lanes.count_ones() as usize;
     }
@@ -315,6 +318,15 @@ impl Stack {
     fn pop(&mut self) -> Option<Entry> {
         self.len = self.len.checked_sub(1)?;
         Some(self.read(self.len))
+    }
+
+    /// The node of the top entry, popped, without its distance (which an
+    /// unsorted push may have left unwritten).
+    #[inline(always)]
+    fn pop_node(&mut self) -> Option<u32> {
+        self.len = self.len.checked_sub(1)?;
+        // SAFETY: slots below `len` have had their node written.
+        Some(unsafe { self.nodes[self.len].assume_init() })
     }
 }
 
@@ -738,6 +750,18 @@ impl WideBvh {
         self.nodes.is_empty()
     }
 
+    /// Node `index`, which must be 0 (the root of a non-empty tree) or a
+    /// node's child: unchecked, since [`WideBvh::build`] writes only the
+    /// indices of nodes it created into `child` (and refits keep them),
+    /// and a bounds check would hold a register through the traversal.
+    #[inline(always)]
+    fn node(&self, index: usize) -> &Node {
+        debug_assert!(index < self.nodes.len());
+        // SAFETY: see above; traversals start at the root only where
+        // `nodes` is not empty.
+        unsafe { self.nodes.get_unchecked(index) }
+    }
+
     /// Visits the leaves that `ray` may hit in (0, `tmax`), inner nodes
     /// nearest first, with [`LeafVisitor::closest`]; boxes beyond the
     /// closest hit so far are skipped.
@@ -749,7 +773,7 @@ impl WideBvh {
         let mut stack = Stack::new();
         let mut current = 0;
         loop {
-            let node = &self.nodes[current];
+            let node = self.node(current);
             let (mask, t_near) = ray.test::<I>(node, tmax);
             // Leaves nearest first, until the next one starts beyond the hit.
             let leaf_lanes = node.leaves();
@@ -778,7 +802,7 @@ impl WideBvh {
                     current = node.child[lane] as usize;
                     continue;
                 }
-            } else {
+            } else if inner != 0 {
                 stack.push::<I>(node, inner, &t_near, true);
             }
             // Next: the nearest pending node that is not beyond the hit.
@@ -802,7 +826,7 @@ impl WideBvh {
         let mut stack = Stack::new();
         let mut current = 0;
         loop {
-            let node = &self.nodes[current];
+            let node = self.node(current);
             let (mask, t_near) = ray.test::<I>(node, tmax);
             let leaf_lanes = node.leaves();
             let mut leaves = mask & leaf_lanes;
@@ -814,8 +838,8 @@ impl WideBvh {
                 }
             }
             stack.push::<I>(node, mask & !leaf_lanes, &t_near, false);
-            match stack.pop() {
-                Some(e) => current = e.node as usize,
+            match stack.pop_node() {
+                Some(node) => current = node as usize,
                 None => return false,
             }
         }
@@ -977,14 +1001,20 @@ mod tests {
             stack.write(0, Entry { node: 7, t: -1.0 });
             stack.len = 1;
             stack.push::<I>(&node, lanes, &t, sorted);
+            // Unsorted pushes need not write the distances: their entries
+            // pop as nodes only (NaN distances here, not checked).
             let mut popped = Vec::new();
-            while let Some(e) = stack.pop() {
+            while let Some(e) = if sorted {
+                stack.pop()
+            } else {
+                stack.pop_node().map(|node| Entry { node, t: f32::NAN })
+            } {
                 popped.push(e);
             }
             let old = popped.pop().expect("the older entry");
             assert_eq!(old.node, 7);
             let got: Vec<usize> = popped.iter().map(|e| (e.node - 100) as usize).collect();
-            for (e, &lane) in popped.iter().zip(&got) {
+            for (e, &lane) in popped.iter().zip(&got).filter(|_| sorted) {
                 assert_eq!(e.t.to_bits(), t[lane].to_bits());
             }
             let mut want: Vec<usize> = (0..WIDTH).filter(|l| lanes & (1 << l) != 0).collect();
