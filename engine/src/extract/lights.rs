@@ -17,7 +17,7 @@
 use super::light_tree::LightTree;
 use crate::settings::LightSelection;
 use radiant_core::glam::Vec3;
-use radiant_core::{Effects, Light, LightBounds};
+use radiant_core::{Effects, Light, LightBounds, PreparedBounds};
 
 /// Most bounded lights whose importance spatial selection evaluates one by
 /// one; more are chosen through a [`LightTree`].
@@ -34,6 +34,8 @@ pub struct LightTable {
     selection: LightSelection,
     /// Spatial selection: the lights with bounds, and theirs.
     bounded: Vec<(u32, LightBounds)>,
+    /// Spatial selection: `bounded`'s bounds prepared for importance.
+    prepared: Vec<PreparedBounds>,
     /// Spatial selection: the lights without bounds.
     unbounded: Vec<u32>,
     /// Spatial selection: the share of the unbounded lights.
@@ -108,6 +110,7 @@ impl LightTable {
                 None => unbounded.push(i as u32),
             }
         }
+        let prepared = bounded.iter().map(|(_, b)| b.prepare()).collect();
         let mut slot_of = vec![u32::MAX; lights.len()];
         for (slot, (i, _)) in bounded.iter().enumerate() {
             slot_of[*i as usize] = slot as u32;
@@ -129,6 +132,7 @@ impl LightTable {
             environment,
             selection,
             bounded,
+            prepared,
             unbounded,
             p_unbounded,
             slot_of,
@@ -184,7 +188,7 @@ impl LightTable {
         // Each importance once; the sum in the order `total_importance` takes.
         let mut weights = [0.0f32; FLAT_LIMIT];
         let mut total = 0.0f32;
-        for ((_, b), w) in self.bounded.iter().zip(&mut weights) {
+        for (b, w) in self.prepared.iter().zip(&mut weights) {
             *w = b.importance(p);
             if *w > 0.0 {
                 total += *w;
@@ -217,7 +221,7 @@ impl LightTable {
             return self.pmf[i];
         }
         let slot = self.slot_of[i] as usize;
-        if let Some((_, b)) = self.bounded.get(slot) {
+        if let Some(b) = self.prepared.get(slot) {
             let share = 1.0 - self.p_unbounded;
             if let Some(tree) = &self.tree {
                 return share * tree.pmf(p, slot);
@@ -240,7 +244,7 @@ impl LightTable {
     #[inline]
     fn total_importance(&self, p: Vec3) -> f32 {
         let mut total = 0.0f32;
-        for (_, b) in &self.bounded {
+        for b in &self.prepared {
             let w = b.importance(p);
             if w > 0.0 {
                 total += w;

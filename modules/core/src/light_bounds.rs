@@ -83,47 +83,22 @@ impl LightBounds {
     /// reach `p`.
     #[inline]
     pub fn importance(&self, p: Vec3) -> f32 {
-        let centre = (self.min + self.max) * 0.5;
+        self.prepare().importance(p)
+    }
+
+    /// The bounds with what [`importance`](Self::importance) derives from
+    /// them computed once, for selection that evaluates it at many points.
+    #[inline]
+    pub fn prepare(&self) -> PreparedBounds {
         let diagonal = self.max - self.min;
-        let to_p = p - centre;
-        let d2 = to_p.length_squared().max(diagonal.length() * 0.5);
-        if d2 <= 0.0 {
-            // A point light at p sends nothing there.
-            return 0.0;
+        PreparedBounds {
+            bounds: *self,
+            centre: (self.min + self.max) * 0.5,
+            half_diagonal: diagonal.length() * 0.5,
+            radius2: diagonal.length_squared() * 0.25,
+            sin_theta_o: sin_from_cos(self.cos_theta_o),
+            isotropic_point: self.cos_theta_o <= -1.0 && self.min == self.max,
         }
-        if self.cos_theta_o <= -1.0 && self.min == self.max {
-            // An isotropic point: no angular bound to apply.
-            return self.phi / d2;
-        }
-        // The angle the box subtends from p (all directions from inside).
-        let radius2 = diagonal.length_squared() * 0.25;
-        let dist2 = to_p.length_squared();
-        let inside = p.cmpge(self.min).all() && p.cmple(self.max).all();
-        let (sin_b, cos_b) = if inside || dist2 <= radius2 {
-            (0.0, -1.0)
-        } else {
-            let sin2 = radius2 / dist2;
-            (sin2.sqrt(), (1.0 - sin2).max(0.0).sqrt())
-        };
-        let len = dist2.sqrt();
-        let mut cos_w = if len > 0.0 {
-            to_p.dot(self.axis) / len
-        } else {
-            1.0
-        };
-        if self.two_sided {
-            cos_w = cos_w.abs();
-        }
-        let sin_w = sin_from_cos(cos_w);
-        let sin_o = sin_from_cos(self.cos_theta_o);
-        // θw − θo, then minus θb.
-        let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, self.cos_theta_o);
-        let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, self.cos_theta_o);
-        let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
-        if cos_p <= self.cos_theta_e {
-            return 0.0;
-        }
-        (self.phi * cos_p / d2).max(0.0)
     }
 
     /// Bounds of surfaces with the given box, the summed area-weighted
@@ -157,6 +132,69 @@ impl LightBounds {
             cos_theta_e: 0.0,
             two_sided: false,
         }
+    }
+}
+
+/// [`LightBounds`] with the box's centre, half diagonal and the sine of
+/// the cone's angle computed once ([`LightBounds::prepare`]): its
+/// [`importance`](Self::importance) is [`LightBounds::importance`], bit
+/// for bit, in fewer operations per point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PreparedBounds {
+    bounds: LightBounds,
+    centre: Vec3,
+    /// Half the box's diagonal (the least distance² importance divides by).
+    half_diagonal: f32,
+    /// The squared radius of the box's bounding sphere.
+    radius2: f32,
+    sin_theta_o: f32,
+    /// A point emitting in every direction: no angular bound applies.
+    isotropic_point: bool,
+}
+
+impl PreparedBounds {
+    /// [`LightBounds::importance`] at `p`.
+    #[inline]
+    pub fn importance(&self, p: Vec3) -> f32 {
+        let b = &self.bounds;
+        let to_p = p - self.centre;
+        let d2 = to_p.length_squared().max(self.half_diagonal);
+        if d2 <= 0.0 {
+            // A point light at p sends nothing there.
+            return 0.0;
+        }
+        if self.isotropic_point {
+            return b.phi / d2;
+        }
+        // The angle the box subtends from p (all directions from inside).
+        let radius2 = self.radius2;
+        let dist2 = to_p.length_squared();
+        let inside = p.cmpge(b.min).all() && p.cmple(b.max).all();
+        let (sin_b, cos_b) = if inside || dist2 <= radius2 {
+            (0.0, -1.0)
+        } else {
+            let sin2 = radius2 / dist2;
+            (sin2.sqrt(), (1.0 - sin2).max(0.0).sqrt())
+        };
+        let len = dist2.sqrt();
+        let mut cos_w = if len > 0.0 {
+            to_p.dot(b.axis) / len
+        } else {
+            1.0
+        };
+        if b.two_sided {
+            cos_w = cos_w.abs();
+        }
+        let sin_w = sin_from_cos(cos_w);
+        let (sin_o, cos_o) = (self.sin_theta_o, b.cos_theta_o);
+        // θw − θo, then minus θb.
+        let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, cos_o);
+        let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, cos_o);
+        let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
+        if cos_p <= b.cos_theta_e {
+            return 0.0;
+        }
+        (b.phi * cos_p / d2).max(0.0)
     }
 }
 
