@@ -17,7 +17,7 @@
 use super::light_tree::LightTree;
 use crate::settings::LightSelection;
 use radiant_core::glam::Vec3;
-use radiant_core::{Effects, Light, LightBounds, PreparedBounds};
+use radiant_core::{BoundsLanes, Effects, Light, LightBounds, PreparedBounds};
 
 /// Most bounded lights whose importance spatial selection evaluates one by
 /// one; more are chosen through a [`LightTree`].
@@ -34,8 +34,9 @@ pub struct LightTable {
     selection: LightSelection,
     /// Spatial selection: the lights with bounds, and theirs.
     bounded: Vec<(u32, LightBounds)>,
-    /// Spatial selection: `bounded`'s bounds prepared for importance.
-    prepared: Vec<PreparedBounds>,
+    /// Spatial selection among at most [`FLAT_LIMIT`] bounded lights:
+    /// their bounds, four lights a lane group, in `bounded`'s order.
+    lanes: Vec<BoundsLanes>,
     /// Spatial selection: the lights without bounds.
     unbounded: Vec<u32>,
     /// Spatial selection: the share of the unbounded lights.
@@ -110,7 +111,12 @@ impl LightTable {
                 None => unbounded.push(i as u32),
             }
         }
-        let prepared = bounded.iter().map(|(_, b)| b.prepare()).collect();
+        let prepared: Vec<PreparedBounds> = bounded.iter().map(|(_, b)| b.prepare()).collect();
+        let lanes = if bounded.len() <= FLAT_LIMIT {
+            prepared.chunks(4).map(BoundsLanes::new).collect()
+        } else {
+            Vec::new()
+        };
         let mut slot_of = vec![u32::MAX; lights.len()];
         for (slot, (i, _)) in bounded.iter().enumerate() {
             slot_of[*i as usize] = slot as u32;
@@ -132,7 +138,7 @@ impl LightTable {
             environment,
             selection,
             bounded,
-            prepared,
+            lanes,
             unbounded,
             p_unbounded,
             slot_of,
@@ -185,15 +191,7 @@ impl LightTable {
                 None => (first as usize, 0.0),
             };
         }
-        // Each importance once; the sum in the order `total_importance` takes.
-        let mut weights = [0.0f32; FLAT_LIMIT];
-        let mut total = 0.0f32;
-        for (b, w) in self.prepared.iter().zip(&mut weights) {
-            *w = b.importance(p);
-            if *w > 0.0 {
-                total += *w;
-            }
-        }
+        let (weights, total) = self.importances(p);
         if total <= 0.0 {
             return (first as usize, 0.0);
         }
@@ -221,14 +219,14 @@ impl LightTable {
             return self.pmf[i];
         }
         let slot = self.slot_of[i] as usize;
-        if let Some(b) = self.prepared.get(slot) {
+        if slot < self.bounded.len() {
             let share = 1.0 - self.p_unbounded;
             if let Some(tree) = &self.tree {
                 return share * tree.pmf(p, slot);
             }
-            let total = self.total_importance(p);
+            let (weights, total) = self.importances(p);
             return if total > 0.0 {
-                share * b.importance(p) / total
+                share * weights[slot] / total
             } else {
                 0.0
             };
@@ -240,17 +238,23 @@ impl LightTable {
         }
     }
 
-    /// Σ importance at `p` over the bounded lights, in their order.
+    /// Each bounded light's importance at `p` (at most [`FLAT_LIMIT`]
+    /// lights, four at a time), and their sum over the positive ones in
+    /// the lights' order: [`select_at`](Self::select_at) and
+    /// [`pmf_at`](Self::pmf_at) take the same one.
     #[inline]
-    fn total_importance(&self, p: Vec3) -> f32 {
+    fn importances(&self, p: Vec3) -> ([f32; FLAT_LIMIT], f32) {
+        let mut weights = [0.0f32; FLAT_LIMIT];
+        for (lanes, w) in self.lanes.iter().zip(weights.chunks_exact_mut(4)) {
+            w.copy_from_slice(&lanes.importance(p).to_array());
+        }
         let mut total = 0.0f32;
-        for b in &self.prepared {
-            let w = b.importance(p);
+        for &w in &weights[..self.bounded.len().min(FLAT_LIMIT)] {
             if w > 0.0 {
                 total += w;
             }
         }
-        total
+        (weights, total)
     }
 
     /// Puts each `(i, light)` of `replacements` in place of light `i`,

@@ -56,7 +56,7 @@ pub use light::{
     Emission, EmissionKind, EmissionPdf, EmissionSample, EmittedRay, EmitterEval, EmitterHit,
     Light, LightSample,
 };
-pub use light_bounds::{LightBounds, PreparedBounds};
+pub use light_bounds::{BoundsLanes, LightBounds, PreparedBounds};
 pub use medium::{Coefficients, Medium, Phase, Profile};
 pub use params::{Color, Numbers, ParamError, Params, TextureInput};
 pub use registry::{ModuleInfo, ModuleKind, ParamDoc, Registry};

@@ -11,7 +11,7 @@
 //! the light cannot send any light to the point, so selection by it stays
 //! unbiased.
 
-use glam::Vec3;
+use glam::{BVec4A, Vec3, Vec4};
 
 /// Where a light is and in which directions it emits.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -198,6 +198,104 @@ impl PreparedBounds {
     }
 }
 
+/// Four lights' [`PreparedBounds`] side by side (structure of arrays), so
+/// that their importance at a point is evaluated for all four at once:
+/// [`importance`](Self::importance) gives each lane's
+/// [`PreparedBounds::importance`] bit for bit (the same IEEE operations in
+/// the same order, branches turned into selects).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoundsLanes {
+    centre: [Vec4; 3],
+    min: [Vec4; 3],
+    max: [Vec4; 3],
+    axis: [Vec4; 3],
+    half_diagonal: Vec4,
+    radius2: Vec4,
+    phi: Vec4,
+    cos_theta_o: Vec4,
+    sin_theta_o: Vec4,
+    cos_theta_e: Vec4,
+    two_sided: BVec4A,
+    isotropic_point: BVec4A,
+}
+
+impl BoundsLanes {
+    /// The lanes of `bounds`, one to four lights (lanes beyond repeat the
+    /// last light).
+    ///
+    /// # Panics
+    ///
+    /// Where `bounds` is empty or holds more than four lights.
+    pub fn new(bounds: &[PreparedBounds]) -> Self {
+        assert!((1..=4).contains(&bounds.len()), "one to four lights");
+        let lane = |i: usize| &bounds[i.min(bounds.len() - 1)];
+        let f = |get: &dyn Fn(&PreparedBounds) -> f32| {
+            Vec4::new(get(lane(0)), get(lane(1)), get(lane(2)), get(lane(3)))
+        };
+        let v = |get: &dyn Fn(&PreparedBounds) -> Vec3| {
+            [0, 1, 2].map(|axis| f(&|b: &PreparedBounds| get(b)[axis]))
+        };
+        let m = |get: &dyn Fn(&PreparedBounds) -> bool| {
+            BVec4A::new(get(lane(0)), get(lane(1)), get(lane(2)), get(lane(3)))
+        };
+        Self {
+            centre: v(&|b| b.centre),
+            min: v(&|b| b.bounds.min),
+            max: v(&|b| b.bounds.max),
+            axis: v(&|b| b.bounds.axis),
+            half_diagonal: f(&|b| b.half_diagonal),
+            radius2: f(&|b| b.radius2),
+            phi: f(&|b| b.bounds.phi),
+            cos_theta_o: f(&|b| b.bounds.cos_theta_o),
+            sin_theta_o: f(&|b| b.sin_theta_o),
+            cos_theta_e: f(&|b| b.bounds.cos_theta_e),
+            two_sided: m(&|b| b.bounds.two_sided),
+            isotropic_point: m(&|b| b.isotropic_point),
+        }
+    }
+
+    /// Each lane's [`PreparedBounds::importance`] at `p`.
+    #[inline]
+    pub fn importance(&self, p: Vec3) -> Vec4 {
+        let (zero, one) = (Vec4::ZERO, Vec4::ONE);
+        let [cx, cy, cz] = self.centre;
+        let (tx, ty, tz) = (
+            Vec4::splat(p.x) - cx,
+            Vec4::splat(p.y) - cy,
+            Vec4::splat(p.z) - cz,
+        );
+        let dist2 = tx * tx + ty * ty + tz * tz;
+        let d2 = dist2.max(self.half_diagonal);
+        let inside = [0, 1, 2].iter().fold(BVec4A::splat(true), |acc, &k| {
+            let q = Vec4::splat(p[k]);
+            acc & q.cmpge(self.min[k]) & q.cmple(self.max[k])
+        });
+        let radius2 = self.radius2;
+        let small = inside | dist2.cmple(radius2);
+        let sin2 = radius2 / dist2;
+        let sin_b = Vec4::select(small, zero, sin2.sqrt());
+        let cos_b = Vec4::select(small, -one, (one - sin2).max(zero).sqrt());
+        let len = dist2.sqrt();
+        let [ax, ay, az] = self.axis;
+        let cos_w = Vec4::select(len.cmpgt(zero), (tx * ax + ty * ay + tz * az) / len, one);
+        let cos_w = Vec4::select(self.two_sided, cos_w.abs(), cos_w);
+        let sin_w = (one - cos_w * cos_w).max(zero).sqrt();
+        let (sin_o, cos_o) = (self.sin_theta_o, self.cos_theta_o);
+        // θw − θo, then minus θb (`cos_sub_clamped`, `sin_sub_clamped`).
+        let within = cos_w.cmpgt(cos_o);
+        let cos_x = Vec4::select(within, one, cos_w * cos_o + sin_w * sin_o);
+        let sin_x = Vec4::select(within, zero, sin_w * cos_o - cos_w * sin_o);
+        let cos_p = Vec4::select(cos_x.cmpgt(cos_b), one, cos_x * cos_b + sin_x * sin_b);
+        let cone = Vec4::select(
+            cos_p.cmple(self.cos_theta_e),
+            zero,
+            (self.phi * cos_p / d2).max(zero),
+        );
+        let value = Vec4::select(self.isotropic_point, self.phi / d2, cone);
+        Vec4::select(d2.cmple(zero), zero, value)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -238,5 +336,58 @@ mod tests {
         assert_eq!(b.importance(Vec3::new(2.0, 0.0, -2.0)), 0.0);
         // Never more than φ / (half diagonal) anywhere.
         assert!(b.importance(Vec3::new(0.0, 0.0, 1e-3)) <= 4.0 / 2f32.sqrt() + 1e-5);
+    }
+
+    #[test]
+    fn lanes_give_each_lights_importance_bit_for_bit() {
+        // Every branch of `importance`: an isotropic point, a spot, one-
+        // and two-sided surfaces, points inside a box and on a point light.
+        let (o, e) = (30f32.to_radians().cos(), 10f32.to_radians().cos());
+        let mut two_sided = LightBounds::surface(
+            Vec3::new(-1.0, 0.5, -1.0),
+            Vec3::new(1.0, 0.5, 1.0),
+            3.0,
+            Vec3::Y,
+            [Vec3::Y].into_iter(),
+        );
+        two_sided.two_sided = true;
+        let lights = [
+            LightBounds::point(Vec3::new(0.3, 1.0, 0.0), 2.0, Vec3::Z, -1.0, 0.0),
+            LightBounds::point(Vec3::new(0.0, 2.0, 0.0), 5.0, -Vec3::Y, o, e),
+            LightBounds::surface(
+                Vec3::new(-1.0, -1.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.2),
+                4.0,
+                Vec3::Z,
+                [Vec3::Z, Vec3::new(0.0, 0.6, 0.8)].into_iter(),
+            ),
+            two_sided,
+        ]
+        .map(|b| b.prepare());
+        let mut points = vec![
+            Vec3::new(0.3, 1.0, 0.0),
+            Vec3::ZERO,
+            Vec3::new(0.5, 0.5, 0.1),
+        ];
+        points.extend((0..2000).map(|i| {
+            let t = i as f32 * 0.618_034;
+            Vec3::new(
+                (t * 1.7).sin() * 3.0,
+                (t * 2.3).cos() * 3.0,
+                (t * 0.9).sin() * 2.0,
+            )
+        }));
+        for n in 1..=4 {
+            let lanes = BoundsLanes::new(&lights[..n]);
+            let mut lit = 0;
+            for &p in &points {
+                let got = lanes.importance(p).to_array();
+                for (b, g) in lights[..n].iter().zip(got) {
+                    assert_eq!(g.to_bits(), b.importance(p).to_bits(), "{n} lights at {p}");
+                    lit += usize::from(g > 0.0);
+                }
+            }
+            assert!(lit > points.len() / 2, "most points see some light");
+        }
     }
 }
