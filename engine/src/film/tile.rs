@@ -3,7 +3,6 @@
 //! sample's filter footprint covers. The beauty's [`super::TileFilm`] and
 //! the first-hit planes' [`super::aov::AovTile`] share it.
 
-use super::{ceil_i32, floor_i32};
 use glam::Vec2;
 
 /// A tile's rectangle of frame pixels, row-major in the tile's buffers.
@@ -60,11 +59,13 @@ impl TileBounds {
     /// none do.
     #[inline]
     pub fn footprint(&self, pos: Vec2, radius: f32) -> (i32, i32, i32, i32) {
+        // One rounding instruction each on x86-64-v2 (the build's target).
+        let (lo, hi) = ((pos - 0.5 - radius).ceil(), (pos - 0.5 + radius).floor());
         (
-            ceil_i32(pos.x - 0.5 - radius).max(0),
-            floor_i32(pos.x - 0.5 + radius).min(self.image_width - 1),
-            ceil_i32(pos.y - 0.5 - radius).max(0),
-            floor_i32(pos.y - 0.5 + radius).min(self.image_height - 1),
+            (lo.x as i32).max(0),
+            (hi.x as i32).min(self.image_width - 1),
+            (lo.y as i32).max(0),
+            (hi.y as i32).min(self.image_height - 1),
         )
     }
 }
