@@ -41,15 +41,19 @@ const TABLE_RES: usize = 64;
 /// radius up to 7.5 pixels); wider filters take the general path.
 const MAX_TAPS: usize = 16;
 
+/// A separable filter's factor g: [`TABLE_RES`] cells over [0, r], then 0.
+type Factor = [f32; TABLE_RES + 1];
+
 /// A filter tabulated over one quadrant [0, r]² (filters are symmetric).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FilterTable {
     radius: f32,
     scale: f32,
     values: Vec<f32>,
-    /// For a separable filter f(x, y) = g(x)·g(y): g tabulated over [0, r],
-    /// so a splat computes one row and one column of weights.
-    separable: Option<Box<[f32; TABLE_RES]>>,
+    /// For a separable filter f(x, y) = g(x)·g(y): g tabulated over [0, r]
+    /// and a zero beyond (the factor outside the support), so a splat
+    /// computes one row and one column of weights.
+    separable: Option<Box<Factor>>,
 }
 
 impl FilterTable {
@@ -99,8 +103,13 @@ impl FilterTable {
     /// The separable factor g at offset `d` (0 outside the support);
     /// `factor` is `separable`.
     #[inline(always)]
-    fn factor(&self, factor: &[f32; TABLE_RES], d: f32) -> f32 {
-        self.index(d).map_or(0.0, |i| factor[i])
+    fn factor(&self, factor: &Factor, d: f32) -> f32 {
+        // The cell, or the zero past the end for |d| beyond the radius (and
+        // NaN, which `min` turns into TABLE_RES): the same as
+        // `index(d).map_or(0.0, …)` without a branch.
+        let x = (d.abs() * self.scale).min(TABLE_RES as f32);
+        // SAFETY: 0 ≤ x ≤ TABLE_RES (not NaN), so the truncation is in range.
+        factor[unsafe { x.to_int_unchecked::<u32>() } as usize]
     }
 
     /// The fast path of a splat at `pos` whose footprint's columns start
@@ -115,7 +124,7 @@ impl FilterTable {
         px0: i32,
         taps: usize,
         wx: &mut [f32; MAX_TAPS],
-    ) -> Option<&[f32; TABLE_RES]> {
+    ) -> Option<&Factor> {
         let g = self.separable.as_deref().filter(|_| taps <= MAX_TAPS)?;
         for (x, w) in (px0..).zip(&mut wx[..taps]) {
             *w = self.factor(g, x as f32 + 0.5 - pos_x);
@@ -126,13 +135,15 @@ impl FilterTable {
 
 /// If the table is the outer product g(x)·g(y) of one function with itself
 /// (box, tent, gaussian and the usual windowed filters are), returns g.
-fn separable_factor(values: &[f32]) -> Option<Box<[f32; TABLE_RES]>> {
+fn separable_factor(values: &[f32]) -> Option<Box<Factor>> {
     let centre = values[0];
     if centre <= 0.0 {
         return None;
     }
     let norm = centre.sqrt();
-    let g: Box<[f32; TABLE_RES]> = Box::new(std::array::from_fn(|i| values[i] / norm));
+    let g: Box<Factor> = Box::new(std::array::from_fn(|i| {
+        if i < TABLE_RES { values[i] / norm } else { 0.0 }
+    }));
     let max = values.iter().fold(0.0f32, |m, v| m.max(v.abs()));
     let tolerance = 1e-5 * max;
     let product_matches = (0..TABLE_RES).all(|iy| {
@@ -313,7 +324,7 @@ impl TileFilm {
         &mut self,
         rows: &RowSplat,
         wx: &[f32; MAX_TAPS],
-        g: &[f32; TABLE_RES],
+        g: &Factor,
         table: &FilterTable,
     ) {
         let w: [f32; N] = std::array::from_fn(|i| wx[i]);
@@ -338,7 +349,7 @@ impl TileFilm {
         rows: &RowSplat,
         taps: usize,
         wx: &[f32; MAX_TAPS],
-        g: &[f32; TABLE_RES],
+        g: &Factor,
         table: &FilterTable,
     ) {
         let width = self.bounds.width as usize;
