@@ -35,12 +35,14 @@ pub enum GpuError {
     },
     /// A module in the scene has no GPU code.
     #[error(
-        "the {kind} `{name}` (type `{type_name}`) has no GPU code, so the scene cannot render with `--backend gpu`; render it with `--backend cpu` (or `auto`)"
+        "the {kind}{} (type `{type_name}`) has no GPU code, so the scene cannot render with `--backend gpu`; render it with `--backend cpu` (or `auto`)",
+        named(name)
     )]
     MissingCode {
         /// The module kind (`material`, `light`, …).
         kind: &'static str,
-        /// Which one: a material's name, a light's number.
+        /// Which one: a material's name, a light's number; empty for the
+        /// scene's one camera, sampler or integrator.
         name: String,
         /// The module type.
         type_name: String,
@@ -79,4 +81,14 @@ pub enum GpuError {
         /// The adapter's limit.
         allowed: u64,
     },
+}
+
+/// The module's name in backticks after a space, or nothing for the
+/// scene's one camera, sampler or integrator.
+fn named(name: &str) -> String {
+    if name.is_empty() {
+        String::new()
+    } else {
+        format!(" `{name}`")
+    }
 }

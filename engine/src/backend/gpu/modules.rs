@@ -99,7 +99,7 @@ impl Modules {
         if !scene.integrator.gpu() {
             return Err(GpuError::MissingCode {
                 kind: "integrator",
-                name: "of the scene".into(),
+                name: String::new(),
                 type_name: crate::backend::cpu::integrator_name(scene).into(),
             });
         }
@@ -126,14 +126,14 @@ impl Modules {
         // Camera and sampler: one instance each.
         let camera = scene.camera.gpu().ok_or_else(|| GpuError::MissingCode {
             kind: "camera",
-            name: "of the scene".into(),
+            name: String::new(),
             type_name: type_of(radiant_core::ModuleKind::Camera),
         })?;
         m.camera.tag(&camera);
         m.params[1] = m.push(&camera);
         let sampler = scene.sampler.gpu().ok_or_else(|| GpuError::MissingCode {
             kind: "sampler",
-            name: "of the scene".into(),
+            name: String::new(),
             type_name: type_of(radiant_core::ModuleKind::Sampler),
         })?;
         m.sampler.tag(&sampler);
