@@ -34,18 +34,26 @@ use radiant_tests::{channel_means, render_edited, root};
 /// `text` with its `integrator:` entry (flow or block style) replaced by
 /// `integrator` (a flow mapping).
 fn with_integrator(text: &str, integrator: &str) -> String {
+    with_entry(text, "integrator", integrator)
+}
+
+/// `text` with every `key:` entry (flow or block style, at any depth)
+/// replaced by `key: value` at the same indentation.
+fn with_entry(text: &str, key: &str, value: &str) -> String {
     let mut out = String::new();
-    let mut skipping = false;
+    // The indentation of the entry being replaced, while its block lasts.
+    let mut replacing: Option<usize> = None;
     for line in text.lines() {
-        if line.starts_with("integrator:") {
-            out += &format!("integrator: {integrator}\n");
-            skipping = true;
+        let indent = line.len() - line.trim_start().len();
+        if replacing.is_some_and(|depth| indent > depth) {
             continue;
         }
-        if skipping && line.starts_with(' ') {
+        replacing = None;
+        if line.trim_start().starts_with(&format!("{key}:")) {
+            out += &format!("{}{key}: {value}\n", &line[..indent]);
+            replacing = Some(indent);
             continue;
         }
-        skipping = false;
         out += line;
         out.push('\n');
     }
@@ -578,24 +586,7 @@ fn strategy_images_sum_to_the_image() {
     // environment scene escaped paths. Mutation check (by hand): leaving
     // out the log of any one of the six kinds of contribution in
     // `integrators/bdpt` fails this test.
-    let boxed = |text: String| {
-        let mut out = String::new();
-        let mut skip = false;
-        for line in text.lines() {
-            if line.trim_start().starts_with("filter:") {
-                out += "  filter: {type: box}\n";
-                skip = !line.contains('{');
-                continue;
-            }
-            if skip && line.starts_with("    ") {
-                continue;
-            }
-            skip = false;
-            out += line;
-            out.push('\n');
-        }
-        out
-    };
+    let boxed = |text: String| with_entry(&text, "filter", "{type: box}");
     // At max_depth 20 a chunk holds 16384 / 21 = 780 samples, fewer than a
     // tile's batch (16 × 16 pixels × 4 spp): the log's slots are offset
     // by the chunk's start there.
