@@ -12,11 +12,15 @@
 //! through a [`LightTree`] in O(log n). [`LightTable::select_at`] and
 //! [`LightTable::pmf_at`] compute the same sums in the same order, so the
 //! probability an emitter hit is weighted with is bit for bit the one its
-//! sample was drawn with.
+//! sample was drawn with. The wavefront asks for a batch of points at once
+//! ([`LightTable::select_many`], [`LightTable::pmf_many`]): the same
+//! values, with each light's importance evaluated at four points per
+//! instruction, so that the points' long chains of square roots and
+//! divisions overlap.
 
 use super::light_tree::LightTree;
 use crate::settings::LightSelection;
-use radiant_core::glam::Vec3;
+use radiant_core::glam::{Vec3, Vec4};
 use radiant_core::{BoundsLanes, Effects, Light, LightBounds, PreparedBounds};
 
 /// Most bounded lights whose importance spatial selection evaluates one by
@@ -37,6 +41,9 @@ pub struct LightTable {
     /// Spatial selection among at most [`FLAT_LIMIT`] bounded lights:
     /// their bounds, four lights a lane group, in `bounded`'s order.
     lanes: Vec<BoundsLanes>,
+    /// The same lights one per lane group (each in all four lanes), to
+    /// weigh four shading points at once ([`LightTable::select_many`]).
+    each: Vec<BoundsLanes>,
     /// Spatial selection: the lights without bounds.
     unbounded: Vec<u32>,
     /// Spatial selection: the share of the unbounded lights.
@@ -112,10 +119,13 @@ impl LightTable {
             }
         }
         let prepared: Vec<PreparedBounds> = bounded.iter().map(|(_, b)| b.prepare()).collect();
-        let lanes = if bounded.len() <= FLAT_LIMIT {
-            prepared.chunks(4).map(BoundsLanes::new).collect()
+        let (lanes, each) = if bounded.len() <= FLAT_LIMIT {
+            (
+                prepared.chunks(4).map(BoundsLanes::new).collect(),
+                prepared.chunks(1).map(BoundsLanes::new).collect(),
+            )
         } else {
-            Vec::new()
+            (Vec::new(), Vec::new())
         };
         let mut slot_of = vec![u32::MAX; lights.len()];
         for (slot, (i, _)) in bounded.iter().enumerate() {
@@ -139,6 +149,7 @@ impl LightTable {
             selection,
             bounded,
             lanes,
+            each,
             unbounded,
             p_unbounded,
             slot_of,
@@ -192,23 +203,94 @@ impl LightTable {
             };
         }
         let (weights, total) = self.importances(p);
+        self.pick_bounded(&weights, total, u)
+    }
+
+    /// [`select_at`](Self::select_at) for each of `points` with its
+    /// sample of `u`: the chosen light into `light` and its probability
+    /// into `prob`, bit for bit as one call per point.
+    pub fn select_many(&self, points: &[Vec3], u: &[f32], light: &mut [u32], prob: &mut [f32]) {
+        let n = points.len().min(u.len()).min(light.len()).min(prob.len());
+        self.per_point(&points[..n], |k, weights| {
+            let (l, p) = match weights {
+                Some(w) if u[k] >= self.p_unbounded => {
+                    self.pick_bounded(w, positive_sum(&w[..self.bounded.len()]), u[k])
+                }
+                _ => self.select_at(points[k], u[k]),
+            };
+            (light[k], prob[k]) = (l as u32, p);
+        });
+    }
+
+    /// [`pmf_at`](Self::pmf_at) for each of `points` and its light of
+    /// `light`, into `pmf`, bit for bit as one call per point.
+    pub fn pmf_many(&self, points: &[Vec3], light: &[u32], pmf: &mut [f32]) {
+        let n = points.len().min(light.len()).min(pmf.len());
+        self.per_point(&points[..n], |k, weights| {
+            let i = light[k] as usize;
+            let slot = self.slot_of[i] as usize;
+            pmf[k] = match weights {
+                Some(w) if slot < self.bounded.len() => {
+                    let total = positive_sum(&w[..self.bounded.len()]);
+                    if total > 0.0 {
+                        (1.0 - self.p_unbounded) * w[slot] / total
+                    } else {
+                        0.0
+                    }
+                }
+                _ => self.pmf_at(points[k], i),
+            };
+        });
+    }
+
+    /// Calls `visit(k, weights)` for each of `points` in order, with the
+    /// bounded lights' importances at `points[k]` where spatial selection
+    /// weighs at most [`FLAT_LIMIT`] lights one by one, else `None`. The
+    /// importances are evaluated one light at four points at a time, a
+    /// block of points per pass: four independent evaluations instead of
+    /// one long chain of square roots and divisions per point.
+    #[inline]
+    fn per_point(&self, points: &[Vec3], mut visit: impl FnMut(usize, Option<&[f32; FLAT_LIMIT]>)) {
+        const BLOCK: usize = 64;
+        if !self.is_spatial() || self.each.is_empty() {
+            for k in 0..points.len() {
+                visit(k, None);
+            }
+            return;
+        }
+        let mut weights = [[0.0f32; FLAT_LIMIT]; BLOCK];
+        for (b, block) in points.chunks(BLOCK).enumerate() {
+            for (slot, lanes) in self.each.iter().enumerate() {
+                for (q, quad) in block.chunks(4).enumerate() {
+                    let coord = |k: usize| {
+                        Vec4::from_array([0, 1, 2, 3].map(|j| quad[j.min(quad.len() - 1)][k]))
+                    };
+                    let w = lanes.importance_at([coord(0), coord(1), coord(2)]);
+                    for (j, w) in w.to_array().into_iter().enumerate().take(quad.len()) {
+                        weights[4 * q + j][slot] = w;
+                    }
+                }
+            }
+            for (j, w) in weights[..block.len()].iter().enumerate() {
+                visit(b * BLOCK + j, Some(w));
+            }
+        }
+    }
+
+    /// The bounded light that `u` (at least the unbounded lights' share)
+    /// picks in proportion to `weights` (the bounded lights' importances
+    /// in their order; `total` the sum of the positive ones), and its
+    /// probability.
+    #[inline]
+    fn pick_bounded(&self, weights: &[f32], total: f32, u: f32) -> (usize, f32) {
+        let first = self.bounded[0].0 as usize;
         if total <= 0.0 {
-            return (first as usize, 0.0);
+            return (first, 0.0);
         }
+        let share = 1.0 - self.p_unbounded;
         let target = (u - self.p_unbounded) / share * total;
-        let mut acc = 0.0f32;
-        let mut last = (first as usize, 0.0f32);
-        for ((i, _), &w) in self.bounded.iter().zip(&weights) {
-            if w <= 0.0 {
-                continue;
-            }
-            acc += w;
-            last = (*i as usize, w);
-            if target < acc {
-                break;
-            }
-        }
-        (last.0, share * last.1 / total)
+        let slot = pick_by_weight(&weights[..self.bounded.len()], target);
+        (self.bounded[slot].0 as usize, share * weights[slot] / total)
     }
 
     /// Probability that [`select_at`](Self::select_at) picks light `i` for
@@ -248,12 +330,7 @@ impl LightTable {
         for (lanes, w) in self.lanes.iter().zip(weights.chunks_exact_mut(4)) {
             w.copy_from_slice(&lanes.importance(p).to_array());
         }
-        let mut total = 0.0f32;
-        for &w in &weights[..self.bounded.len().min(FLAT_LIMIT)] {
-            if w > 0.0 {
-                total += w;
-            }
-        }
+        let total = positive_sum(&weights[..self.bounded.len().min(FLAT_LIMIT)]);
         (weights, total)
     }
 
@@ -323,16 +400,53 @@ impl LightTable {
     }
 }
 
+/// The entry of `weights` that the inverse of their running sum picks for
+/// `target` in [0, sum): the first entry whose running sum exceeds it, a
+/// positive one (entries ≤ 0 count as 0); where rounding puts `target` at
+/// or past the sum, the last positive entry. Branch-free over the entries:
+/// a loop that stopped at the picked entry would mispredict about once per
+/// shading point.
+#[inline]
+fn pick_by_weight(weights: &[f32], target: f32) -> usize {
+    let mut sum = 0.0f32;
+    let mut below = 0usize;
+    for &w in weights {
+        sum += if w > 0.0 { w } else { 0.0 };
+        below += usize::from(sum <= target);
+    }
+    if below < weights.len() {
+        return below;
+    }
+    weights.iter().rposition(|&w| w > 0.0).unwrap_or(0)
+}
+
+/// The sum of the positive entries of `weights`, in their order.
+#[inline]
+fn positive_sum(weights: &[f32]) -> f32 {
+    let mut total = 0.0f32;
+    for &w in weights {
+        if w > 0.0 {
+            total += w;
+        }
+    }
+    total
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use radiant_core::LightSample;
     use radiant_core::glam::{Vec2, Vec3};
+    use radiant_core::{LightBounds, LightSample};
 
-    struct Fixed(f32);
+    /// A delta light of the given power, with bounds where spatial
+    /// selection should weigh it.
+    struct Fixed(f32, Option<LightBounds>);
     impl Light for Fixed {
         fn power(&self) -> f32 {
             self.0
+        }
+        fn bounds(&self) -> Option<LightBounds> {
+            self.1
         }
         fn is_delta(&self) -> bool {
             true
@@ -343,12 +457,60 @@ mod tests {
         }
     }
 
+    /// The branch-free pick against the scan it replaced (skip entries
+    /// ≤ 0, stop at the first running sum above the target, else keep the
+    /// last positive entry), on weights with zeros and targets on and
+    /// past the running sums' boundaries.
+    #[test]
+    fn pick_by_weight_is_the_inverse_of_the_running_sum() {
+        let scan = |weights: &[f32], target: f32| {
+            let (mut acc, mut last) = (0.0f32, 0);
+            for (i, &w) in weights.iter().enumerate() {
+                if w <= 0.0 {
+                    continue;
+                }
+                acc += w;
+                last = i;
+                if target < acc {
+                    break;
+                }
+            }
+            last
+        };
+        let cases: [&[f32]; 5] = [
+            &[1.0],
+            &[0.25, 0.75],
+            &[0.0, 0.5, 0.0, 0.5, 0.0],
+            &[
+                3.0, 0.0, 1e-9, 2.0, 0.0, 0.0, 5.0, 1.0, 0.5, 0.0, 0.0, 0.0, 7.0, 0.0, 0.1, 0.0,
+            ],
+            &[0.0, 0.0, 2.0, 0.0],
+        ];
+        for weights in cases {
+            let total: f32 = weights.iter().filter(|&&w| w > 0.0).sum();
+            let mut targets: Vec<f32> = (0..=1000).map(|i| i as f32 / 1000.0 * total).collect();
+            let mut sum = 0.0f32;
+            for &w in weights {
+                sum += w.max(0.0);
+                targets.extend([sum, sum.next_down(), sum.next_up()]);
+            }
+            // Targets are never negative: u ≥ the unbounded lights' share.
+            for target in targets.into_iter().filter(|&t| t >= 0.0) {
+                assert_eq!(
+                    pick_by_weight(weights, target),
+                    scan(weights, target),
+                    "{weights:?} at {target}"
+                );
+            }
+        }
+    }
+
     fn counts(selection: LightSelection) -> [usize; 3] {
         let table = LightTable::new(
             vec![
-                Box::new(Fixed(1.0)),
-                Box::new(Fixed(3.0)),
-                Box::new(Fixed(0.0)),
+                Box::new(Fixed(1.0, None)),
+                Box::new(Fixed(3.0, None)),
+                Box::new(Fixed(0.0, None)),
             ],
             selection,
         );
@@ -367,6 +529,59 @@ mod tests {
     fn selection_is_proportional_to_power() {
         let [a, b, c] = counts(LightSelection::Power);
         assert!(a.abs_diff(2500) <= 1 && b.abs_diff(7499) <= 1 && c == 0);
+    }
+
+    /// The batch calls against one call per point, bit for bit: 1, 2, 5
+    /// and 16 bounded lights (the lane groups' edges), with and without
+    /// an unbounded light, over more points than one block.
+    #[test]
+    fn batches_choose_and_weigh_as_one_call_per_point() {
+        let cos = |deg: f32| deg.to_radians().cos();
+        for (bounded, with_unbounded) in
+            [(1, false), (2, false), (5, true), (16, false), (16, true)]
+        {
+            let mut lights: Vec<Box<dyn Light>> = (0..bounded)
+                .map(|i| {
+                    let t = i as f32;
+                    let at = Vec3::new((t * 1.3).sin() * 2.0, 2.0 + t * 0.1, (t * 0.7).cos());
+                    let b = LightBounds::point(at, 1.0 + t, -Vec3::Y, cos(60.0 + t), cos(20.0));
+                    Box::new(Fixed(b.phi, Some(b))) as Box<dyn Light>
+                })
+                .collect();
+            if with_unbounded {
+                lights.push(Box::new(Fixed(2.0, None)));
+            }
+            let table = LightTable::new(lights, LightSelection::Spatial);
+            let n = 203;
+            let points: Vec<Vec3> = (0..n)
+                .map(|i| {
+                    let t = i as f32 * 0.618_034;
+                    Vec3::new(
+                        (t * 1.7).sin() * 3.0,
+                        (t * 2.3).cos(),
+                        (t * 0.9).sin() * 2.0,
+                    )
+                })
+                .collect();
+            let u: Vec<f32> = (0..n).map(|i| (i as f32 * 0.754_877_7).fract()).collect();
+            let (mut light, mut prob) = (vec![0u32; n], vec![0.0f32; n]);
+            table.select_many(&points, &u, &mut light, &mut prob);
+            let mut pmf = vec![0.0f32; n];
+            table.pmf_many(&points, &light, &mut pmf);
+            let mut lit = 0;
+            for k in 0..n {
+                let (l, p) = table.select_at(points[k], u[k]);
+                assert_eq!(
+                    (light[k], prob[k].to_bits()),
+                    (l as u32, p.to_bits()),
+                    "{k}"
+                );
+                let q = table.pmf_at(points[k], l);
+                assert_eq!(pmf[k].to_bits(), q.to_bits(), "{k}");
+                lit += usize::from(p > 0.0);
+            }
+            assert!(lit > n / 2, "most points have a light to choose");
+        }
     }
 
     #[test]

@@ -112,6 +112,8 @@ pub struct Wavefront {
     light: Vec<u32>,
     light_prob: Vec<f32>,
     light_sample: Vec<LightSample>,
+    /// The live paths' shading points, in `live`'s order.
+    points: Vec<Vec3>,
     // Grouping by light.
     by_light: Vec<u32>,
     light_offsets: Vec<u32>,
@@ -122,6 +124,10 @@ pub struct Wavefront {
     em_slots: Vec<u32>,
     em_hits: Vec<EmitterHit>,
     em_evals: Vec<EmitterEval>,
+    /// The light of each emitter hit, and its selection probability from
+    /// the hit's ray origin.
+    em_light: Vec<u32>,
+    em_pmf: Vec<f32>,
     // Rays that left the scene (environment lights).
     esc_slots: Vec<u32>,
     esc_dirs: Vec<Vec3>,
@@ -644,14 +650,24 @@ impl Wavefront {
                     .eval_hits(&self.em_hits[a..b], &mut self.em_evals[a..b]);
             }
         }
+        let m = self.em_slots.len();
+        fit(&mut self.points, m);
+        fit(&mut self.em_light, m);
+        fit(&mut self.em_pmf, m);
         for light in 0..nlights {
-            for k in self.offsets[light] as usize..self.offsets[light + 1] as usize {
-                let i = self.em_slots[k] as usize;
-                let e = self.em_evals[k];
-                let pmf = scene.lights.pmf_at(self.em_hits[k].origin, light);
-                let w = bsdf_hit_weight(depth, self.prev_pdf[i], pmf * e.pdf);
-                self.radiance[i] += self.beta[i] * e.radiance * w;
-            }
+            let (a, b) = (self.offsets[light], self.offsets[light + 1]);
+            self.em_light[a as usize..b as usize].fill(light as u32);
+        }
+        for (p, h) in self.points.iter_mut().zip(&self.em_hits) {
+            *p = h.origin;
+        }
+        let lights = &scene.lights;
+        lights.pmf_many(&self.points, &self.em_light, &mut self.em_pmf);
+        let em = self.em_slots.iter().zip(&self.em_evals).zip(&self.em_pmf);
+        for ((&slot, e), &pmf) in em {
+            let i = slot as usize;
+            let w = bsdf_hit_weight(depth, self.prev_pdf[i], pmf * e.pdf);
+            self.radiance[i] += self.beta[i] * e.radiance * w;
         }
     }
 
@@ -805,12 +821,15 @@ impl Wavefront {
     ) {
         fit(&mut self.u1, n);
         sampler.fill_1d(&self.ids_k, base, &mut self.u1);
-        for k in 0..n {
-            let at = self.its[self.live[k] as usize].p;
-            let (l, p) = scene.lights.select_at(at, self.u1[k]);
-            self.light[k] = l as u32;
-            self.light_prob[k] = p;
+        fit(&mut self.points, n);
+        let its = &self.its[..];
+        for (p, &slot) in self.points.iter_mut().zip(&self.live) {
+            *p = its[slot as usize].p;
         }
+        let (points, u) = (&self.points[..n], &self.u1[..n]);
+        scene
+            .lights
+            .select_many(points, u, &mut self.light, &mut self.light_prob);
         self.by_light.clear();
         self.by_light.extend(0..n as u32);
         let lights = &self.light;
@@ -828,7 +847,7 @@ impl Wavefront {
         fit(&mut self.light_out, n);
         for (j, &k) in self.by_light.iter().enumerate() {
             let k = k as usize;
-            self.refs[j] = self.its[self.live[k] as usize].p;
+            self.refs[j] = self.points[k];
             self.light_u[j] = self.u2[k];
         }
         for l in 0..scene.lights.len() {

@@ -257,18 +257,24 @@ impl BoundsLanes {
     /// Each lane's [`PreparedBounds::importance`] at `p`.
     #[inline]
     pub fn importance(&self, p: Vec3) -> Vec4 {
+        self.importance_at(p.to_array().map(Vec4::splat))
+    }
+
+    /// Each lane's [`PreparedBounds::importance`] at its own point, given
+    /// as lanes of coordinates `[x, y, z]`. With one light in every lane
+    /// (`new(&[bounds])`) this evaluates one light at four points, which
+    /// is how a batch of shading points is weighed: four independent
+    /// evaluations rather than one long chain of square roots and
+    /// divisions per point.
+    #[inline]
+    pub fn importance_at(&self, p: [Vec4; 3]) -> Vec4 {
         let (zero, one) = (Vec4::ZERO, Vec4::ONE);
         let [cx, cy, cz] = self.centre;
-        let (tx, ty, tz) = (
-            Vec4::splat(p.x) - cx,
-            Vec4::splat(p.y) - cy,
-            Vec4::splat(p.z) - cz,
-        );
+        let (tx, ty, tz) = (p[0] - cx, p[1] - cy, p[2] - cz);
         let dist2 = tx * tx + ty * ty + tz * tz;
         let d2 = dist2.max(self.half_diagonal);
         let inside = [0, 1, 2].iter().fold(BVec4A::splat(true), |acc, &k| {
-            let q = Vec4::splat(p[k]);
-            acc & q.cmpge(self.min[k]) & q.cmple(self.max[k])
+            acc & p[k].cmpge(self.min[k]) & p[k].cmple(self.max[k])
         });
         let radius2 = self.radius2;
         let small = inside | dist2.cmple(radius2);
@@ -388,6 +394,17 @@ mod tests {
                 }
             }
             assert!(lit > points.len() / 2, "most points see some light");
+        }
+        // One light in every lane, four points at a time.
+        for b in &lights {
+            let lanes = BoundsLanes::new(&[*b]);
+            for quad in points.chunks_exact(4) {
+                let at = [0, 1, 2].map(|k| Vec4::from_array([0, 1, 2, 3].map(|j| quad[j][k])));
+                let got = lanes.importance_at(at).to_array();
+                for (p, g) in quad.iter().zip(got) {
+                    assert_eq!(g.to_bits(), b.importance(*p).to_bits(), "at {p}");
+                }
+            }
         }
     }
 }
