@@ -23,7 +23,7 @@ use crate::accel::offset::{sphere_error, triangle_point};
 use crate::accel::{Hit, Placement, Primitive};
 use crate::extract::{BARYCENTRIC_UVS, RenderScene};
 use glam::{Vec2, Vec3};
-use radiant_core::Frame;
+use radiant_core::{Effects, Frame};
 use std::f32::consts::{FRAC_1_PI, PI, TAU};
 
 /// A ray's hit, resolved into geometry and shading data.
@@ -169,7 +169,11 @@ fn local_interaction<const TANGENTS: bool>(
                 above_tangent_plane(ns.unwrap_or(ng), ng)
             });
             let uvs = scene.surfaces.uvs[i];
-            let uv = uvs[0] * b[0] + uvs[1] * b[1] + uvs[2] * b[2];
+            let uv = if textured(scene) {
+                uvs[0] * b[0] + uvs[1] * b[1] + uvs[2] * b[2]
+            } else {
+                Vec2::ZERO
+            };
             let (frame, dp) = if TANGENTS {
                 let ns = ns.unwrap_or(ng);
                 let tangent = scene
@@ -198,10 +202,14 @@ fn local_interaction<const TANGENTS: bool>(
             // Texture coordinates in the sphere's object space (Mitsuba 3's).
             let rows = scene.surfaces.normals[i];
             let local = Vec3::new(rows[0].dot(n), rows[1].dot(n), rows[2].dot(n));
-            let uv = Vec2::new(
-                (local.y.atan2(local.x) * FRAC_1_PI * 0.5).rem_euclid(1.0),
-                local.z.clamp(-1.0, 1.0).acos() * FRAC_1_PI,
-            );
+            let uv = if textured(scene) {
+                Vec2::new(
+                    (local.y.atan2(local.x) * FRAC_1_PI * 0.5).rem_euclid(1.0),
+                    local.z.clamp(-1.0, 1.0).acos() * FRAC_1_PI,
+                )
+            } else {
+                Vec2::ZERO
+            };
             let (frame, dp) = if TANGENTS {
                 sphere_frame(n, local, &rows, radius)
             } else {
@@ -217,6 +225,14 @@ fn local_interaction<const TANGENTS: bool>(
             (it, dp)
         }
     }
+}
+
+/// Whether hits need texture coordinates: only where a module of the
+/// frame declares [`Effects::TEXTURES`] (a sphere's take an `atan2` and
+/// an `acos`); elsewhere they are zero.
+#[inline(always)]
+fn textured(scene: &RenderScene) -> bool {
+    scene.effects.contains(Effects::TEXTURES)
 }
 
 /// The shading frame around `ns` of a point of triangle `v` with vertex

@@ -19,7 +19,10 @@ use glam::{Vec2, Vec3};
 pub struct SurfaceBatch<'a> {
     /// Outgoing directions, local frame, unit length.
     pub wo: &'a [Vec3],
-    /// Surface texture coordinates.
+    /// Surface texture coordinates; zero unless the frame's effects
+    /// contain [`Effects::TEXTURES`](crate::Effects), which every varying
+    /// texture declares (a shader that reads them without a texture
+    /// declares it too).
     pub uv: &'a [Vec2],
     /// ∂p/∂u in the local shading frame, with its length (scene units per
     /// unit of u); empty unless the frame's effects contain
