@@ -152,29 +152,90 @@ impl AreaLight {
 
     /// A point on part `part` (with its normal) for `origin`, and the
     /// solid-angle density of the whole strategy for it.
-    #[inline]
+    #[inline(always)]
     fn sample_part(&self, part: usize, origin: Vec3, u: Vec2) -> (Vec3, Vec3, f32) {
-        match self.parts[part] {
+        let probability = self.part_probability(part);
+        match &self.parts[part] {
             Part::Rectangle(rect) => {
                 if let Some(s) = rect.spherical(origin) {
-                    let pdf = self.part_probability(part) / s.solid_angle;
-                    return (s.sample(u), rect.n, pdf);
+                    return (s.sample(u), rect.n, probability / s.solid_angle);
                 }
+                let p = rect.point(u);
+                (p, rect.n, self.area_pdf(origin, p, rect.n))
             }
-            Part::Sphere(centre, r) => {
-                if let Some(cone) = Cone::new(centre, r, origin) {
-                    let (p, n) = cone.sample(centre, r, origin, u);
-                    return (p, n, self.part_probability(part) * cone.pdf());
-                }
+            &Part::Sphere(centre, r) => self.sample_sphere(centre, r, probability, origin, u),
+            Part::Triangle(..) => {
+                let (p, n) = self.point_by_area(part, u);
+                (p, n, self.area_pdf(origin, p, n))
             }
-            Part::Triangle(..) => {}
         }
-        let (p, n) = self.point_by_area(part, u);
-        (p, n, self.area_pdf(origin, p, n))
+    }
+
+    /// A point on the sphere (`centre`, `r`), picked with `probability`,
+    /// for `origin`, its normal and the solid-angle density of the whole
+    /// strategy for it: in the cone the sphere subtends from outside, by
+    /// area from inside.
+    #[inline(always)]
+    fn sample_sphere(
+        &self,
+        centre: Vec3,
+        r: f32,
+        probability: f32,
+        origin: Vec3,
+        u: Vec2,
+    ) -> (Vec3, Vec3, f32) {
+        match Cone::new(centre, r, origin) {
+            Some(cone) => {
+                let (p, n) = cone.sample(centre, r, origin, u);
+                (p, n, probability * cone.pdf())
+            }
+            None => {
+                let n = square_to_uniform_sphere(u);
+                let p = centre + n * r;
+                (p, n, self.area_pdf(origin, p, n))
+            }
+        }
+    }
+
+    /// Samples a light of one rectangle in two tight passes over the
+    /// batch: by area for every reference point, then by solid angle for
+    /// the few near it (what [`Self::sample_part`] does in one).
+    fn sample_rectangle(
+        &self,
+        rect: &Rectangle,
+        refs: &[Vec3],
+        u: &[Vec2],
+        out: &mut [LightSample],
+    ) {
+        for ((r, u), o) in refs.iter().zip(u).zip(out.iter_mut()) {
+            let p = rect.point(*u);
+            *o = self.light_sample(p, rect.n, self.area_pdf(*r, p, rect.n));
+        }
+        let probability = self.part_probability(0);
+        for ((r, u), o) in refs.iter().zip(u).zip(out.iter_mut()) {
+            if rect.is_near(*r)
+                && let Some(s) = rect.spherical(*r)
+            {
+                *o = self.light_sample(s.sample(*u), rect.n, probability / s.solid_angle);
+            }
+        }
+    }
+
+    /// The sample at `p` (normal `n`) of density `pdf`; a failed one
+    /// (radiance and density 0) where `pdf` is not positive and finite.
+    #[inline(always)]
+    fn light_sample(&self, p: Vec3, n: Vec3, pdf: f32) -> LightSample {
+        let ok = pdf > 0.0 && pdf.is_finite();
+        LightSample {
+            p,
+            n,
+            radiance: if ok { self.radiance } else { Rgb::ZERO },
+            pdf: if ok { pdf } else { 0.0 },
+        }
     }
 
     /// A point of part `part` (with its normal), uniform by area.
-    #[inline]
+    #[inline(always)]
     fn point_by_area(&self, part: usize, u: Vec2) -> (Vec3, Vec3) {
         match self.parts[part] {
             Part::Triangle([a, b, c], n) => {
@@ -213,7 +274,7 @@ impl AreaLight {
 
     /// Solid-angle density of point `p` (normal `n`) from `origin` when
     /// its part is sampled by area; 0 if `p` faces away.
-    #[inline]
+    #[inline(always)]
     fn area_pdf(&self, origin: Vec3, p: Vec3, n: Vec3) -> f32 {
         // dist² / (cos θ · area) with cos θ = n·d / dist: one division.
         let d = origin - p;
@@ -267,24 +328,24 @@ impl Light for AreaLight {
     }
 
     fn sample(&self, refs: &[Vec3], u: &[Vec2], out: &mut [LightSample]) {
-        for ((r, u), o) in refs.iter().zip(u).zip(out.iter_mut()) {
-            let (part, ux) = self.pick(u.x);
-            let (p, n, pdf) = self.sample_part(part, *r, Vec2::new(ux, u.y));
-            *o = if pdf > 0.0 && pdf.is_finite() {
-                LightSample {
-                    p,
-                    n,
-                    radiance: self.radiance,
-                    pdf,
+        // One part (the usual `rectangle` or `sphere` emitter): a loop
+        // without picking or dispatch per sample.
+        match self.parts.as_slice() {
+            [Part::Rectangle(rect)] => self.sample_rectangle(rect, refs, u, out),
+            &[Part::Sphere(centre, r)] => {
+                let probability = self.part_probability(0);
+                for ((origin, u), o) in refs.iter().zip(u).zip(out.iter_mut()) {
+                    let (p, n, pdf) = self.sample_sphere(centre, r, probability, *origin, *u);
+                    *o = self.light_sample(p, n, pdf);
                 }
-            } else {
-                LightSample {
-                    p,
-                    n,
-                    radiance: Rgb::ZERO,
-                    pdf: 0.0,
+            }
+            _ => {
+                for ((r, u), o) in refs.iter().zip(u).zip(out.iter_mut()) {
+                    let (part, ux) = self.pick(u.x);
+                    let (p, n, pdf) = self.sample_part(part, *r, Vec2::new(ux, u.y));
+                    *o = self.light_sample(p, n, pdf);
                 }
-            };
+            }
         }
     }
 

@@ -76,8 +76,17 @@ impl Rectangle {
     }
 
     /// The point at (s, t) ∈ [0, 1]².
+    #[inline(always)]
     pub fn point(&self, u: Vec2) -> Vec3 {
         self.corner + self.ex * u.x + self.ey * u.y
+    }
+
+    /// Whether `origin` is on the emitting side and near enough for
+    /// solid-angle sampling (the cheap first test of [`Self::spherical`]).
+    #[inline(always)]
+    pub fn is_near(&self, origin: Vec3) -> bool {
+        self.n.dot(origin - self.corner) > 0.0
+            && (self.centre - origin).length_squared() <= NEAR * self.area
     }
 
     /// The rectangle as seen from `origin` for solid-angle sampling, if
@@ -85,9 +94,7 @@ impl Rectangle {
     /// within the reliable range.
     #[inline]
     pub fn spherical(&self, origin: Vec3) -> Option<SphericalRectangle> {
-        if self.n.dot(origin - self.corner) <= 0.0
-            || (self.centre - origin).length_squared() > NEAR * self.area
-        {
+        if !self.is_near(origin) {
             return None;
         }
         SphericalRectangle::new(origin, self.corner, self.ex, self.ey)
