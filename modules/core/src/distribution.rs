@@ -2,8 +2,14 @@
 //!
 //! A module that samples a tabulated function (a pixel filter's footprint,
 //! an environment map) builds one of these once, at build time, from
-//! non-negative cell weights; sampling is then two binary searches and no
+//! non-negative cell weights; sampling is then two short searches and no
 //! allocation.
+//!
+//! Each 1D distribution keeps a guide table (the cutpoint method of Chen
+//! and Asau 1974): for `g` equal steps of u, the first cell that u at the
+//! step's start can fall in. A sample searches only the cells between two
+//! neighbouring entries (usually one or two) instead of the whole CDF, and
+//! finds the very cell the whole-CDF search finds.
 
 use glam::{UVec2, Vec2};
 
@@ -12,6 +18,11 @@ use glam::{UVec2, Vec2};
 pub struct Distribution1D {
     /// Cumulative probabilities, `n + 1` entries from 0 to 1.
     cdf: Vec<f32>,
+    /// `g + 1` entries for a power of two `g`: entry k is where
+    /// [`Distribution1D::search`] puts u = k / g (0 for k = 0, so that a
+    /// negative or NaN u searches from the start), the last one is
+    /// `n + 1`.
+    guide: Vec<u32>,
     /// Sum of the weights.
     total: f64,
 }
@@ -34,7 +45,25 @@ impl Distribution1D {
             cdf.push(acc as f32);
         }
         cdf[n] = 1.0;
-        Self { cdf, total }
+        let g = n.next_power_of_two();
+        let mut guide: Vec<u32> = (0..g)
+            .map(|k| cdf.partition_point(|&c| c <= k as f32 / g as f32) as u32)
+            .collect();
+        guide[0] = 0;
+        guide.push(cdf.len() as u32);
+        Self { cdf, guide, total }
+    }
+
+    /// The number of CDF entries ≤ `u`, found between the guide table's
+    /// entries around `u`: u ∈ [k/g, (k+1)/g) (exact, g is a power of two)
+    /// puts it between entries k and k + 1, as the CDF is non-decreasing.
+    #[inline]
+    fn search(&self, u: f32) -> usize {
+        let g = self.guide.len() - 1;
+        // The float-to-int cast saturates: negative and NaN u give 0.
+        let k = ((u * g as f32) as usize).min(g - 1);
+        let (lo, hi) = (self.guide[k] as usize, self.guide[k + 1] as usize);
+        lo + self.cdf[lo..hi].partition_point(|&c| c <= u)
     }
 
     /// Number of cells.
@@ -70,7 +99,7 @@ impl Distribution1D {
     #[inline]
     pub fn sample(&self, u: f32) -> (usize, f32) {
         let n = self.len();
-        let i = self.cdf.partition_point(|&c| c <= u).clamp(1, n) - 1;
+        let i = self.search(u).clamp(1, n) - 1;
         let width = self.cdf[i + 1] - self.cdf[i];
         let rest = if width > 0.0 {
             ((u - self.cdf[i]) / width).clamp(0.0, crate::ONE_MINUS_EPSILON)
@@ -163,6 +192,32 @@ mod tests {
         assert_eq!(i, 2);
         assert!((r - 0.5).abs() < 1e-6);
         assert!(d.sample(0.999_999).1 < 1.0);
+    }
+
+    #[test]
+    fn the_guide_table_finds_the_cell_the_whole_cdf_search_finds() {
+        // Uneven weights with empty cells and runs of tiny ones, so that
+        // guide steps hold many cells or none, and u on the CDF's values.
+        let weights: Vec<f32> = (0..37)
+            .map(|i| match i % 7 {
+                0 => 0.0,
+                3 => 40.0,
+                _ => 1e-3 * i as f32,
+            })
+            .collect();
+        for d in [Distribution1D::new(&weights), Distribution1D::new(&[2.0])] {
+            let mut us: Vec<f32> = (0..=4096).map(|i| i as f32 / 4096.0).collect();
+            us.extend(
+                d.cdf()
+                    .iter()
+                    .flat_map(|&c| [c, c.next_down(), c.next_up()]),
+            );
+            us.extend([-1.0, f32::NAN, 1.0, 2.0, f32::INFINITY, -0.0]);
+            for u in us {
+                let whole = d.cdf.partition_point(|&c| c <= u);
+                assert_eq!(d.search(u), whole, "u = {u}");
+            }
+        }
     }
 
     #[test]
