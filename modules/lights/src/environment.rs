@@ -93,6 +93,9 @@ struct Map {
     /// Over the cells between pixel centres, by the mean of their corners'
     /// weights.
     distribution: Distribution2D,
+    /// The distribution's density of each cell, row-major (a lookup
+    /// instead of two through the rows' tables).
+    cell_pdf: Vec<f32>,
     /// The GPU parameters of the map, made on first use.
     gpu: GpuCache,
 }
@@ -227,12 +230,17 @@ impl EnvironmentLight {
         );
         // ∫ L dω = ∫∫ L sin θ 2π² du dv, the cells' means times their area.
         let integral = (2.0 * PI * PI / (w * (h - 1)) as f32) * distribution.total() as f32;
+        let cell_pdf = (0..size.y - 1)
+            .flat_map(|y| (0..size.x).map(move |x| UVec2::new(x, y)))
+            .map(|cell| distribution.pdf(cell))
+            .collect();
         Ok(Self {
             emission: Emission::Map(Arc::new(Map {
                 size,
                 texels: pixels,
                 weights,
                 distribution,
+                cell_pdf,
                 gpu: GpuCache::default(),
             })),
             to_render,
@@ -332,6 +340,12 @@ struct Patch {
     t: Vec2,
 }
 
+/// The column after `x` (< `w`) in a map `w` wide, wrapping in u.
+#[inline(always)]
+fn next_column(x: usize, w: usize) -> usize {
+    if x + 1 == w { 0 } else { x + 1 }
+}
+
 impl Map {
     /// The map's words for `environment.wgsl` (see its header): size,
     /// the offsets of the tables, then the pixel weights, the marginal CDF
@@ -369,11 +383,19 @@ impl Map {
         let fx = u * w as f32 - 0.5;
         let fy = v * (h - 1) as f32;
         let xf = fx.floor();
-        let x0 = (xf as isize).rem_euclid(w as isize) as usize;
+        // x0 = xf mod w, without a division for the usual −1 ≤ xf < w.
+        let (x, wi) = (xf as isize, w as isize);
+        let x0 = if (0..wi).contains(&x) {
+            x
+        } else if (-wi..0).contains(&x) {
+            x + wi
+        } else {
+            x.rem_euclid(wi)
+        } as usize;
         let y0 = (fy as usize).min(h - 2);
         Patch {
             x0,
-            x1: (x0 + 1) % w,
+            x1: next_column(x0, w),
             y0,
             t: Vec2::new(fx - xf, fy - y0 as f32),
         }
@@ -411,9 +433,9 @@ impl Map {
         if sin_theta <= 0.0 {
             return 0.0;
         }
-        let cell = UVec2::new(at.x0 as u32, at.y0 as u32);
+        let cell = self.cell_pdf[at.y0 * self.size.x as usize + at.x0];
         let patch = bilinear_pdf(at.t, self.corners(&self.weights, at));
-        self.distribution.pdf(cell) * patch / (2.0 * PI * PI * sin_theta)
+        cell * patch / (2.0 * PI * PI * sin_theta)
     }
 
     /// A light-space direction for the sample `u`, with its radiance and
@@ -426,7 +448,7 @@ impl Map {
         let w = self.size.x as usize;
         let mut at = Patch {
             x0: x,
-            x1: (x + 1) % w,
+            x1: next_column(x, w),
             y0: y,
             t: Vec2::ZERO,
         };
@@ -456,18 +478,27 @@ impl Light for EnvironmentLight {
 
     fn sample(&self, refs: &[Vec3], u: &[Vec2], out: &mut [LightSample]) {
         let reach = 2.0 * self.sphere.radius;
-        for ((r, u), o) in refs.iter().zip(u).zip(out.iter_mut()) {
-            let (local, radiance, pdf) = match &self.emission {
-                Emission::Constant(c) => (square_to_uniform_sphere(*u), *c, UNIFORM_SPHERE_PDF),
-                Emission::Map(m) => m.sample(*u),
-            };
+        let to_sample = |r: Vec3, (local, radiance, pdf): (Vec3, Rgb, f32)| {
             let wi = self.to_render * local;
-            *o = LightSample {
-                p: *r + wi * reach,
+            LightSample {
+                p: r + wi * reach,
                 n: Vec3::ZERO,
                 radiance: if pdf > 0.0 { radiance } else { Rgb::ZERO },
                 pdf,
-            };
+            }
+        };
+        let samples = refs.iter().zip(u).zip(out.iter_mut());
+        match &self.emission {
+            Emission::Constant(c) => {
+                for ((r, u), o) in samples {
+                    *o = to_sample(*r, (square_to_uniform_sphere(*u), *c, UNIFORM_SPHERE_PDF));
+                }
+            }
+            Emission::Map(m) => {
+                for ((r, u), o) in samples {
+                    *o = to_sample(*r, m.sample(*u));
+                }
+            }
         }
     }
 
