@@ -213,9 +213,7 @@ impl AreaLight {
         }
         let probability = self.part_probability(0);
         for ((r, u), o) in refs.iter().zip(u).zip(out.iter_mut()) {
-            if rect.is_near(*r)
-                && let Some(s) = rect.spherical(*r)
-            {
+            if let Some(s) = rect.spherical(*r) {
                 *o = self.light_sample(s.sample(*u), rect.n, probability / s.solid_angle);
             }
         }
@@ -254,7 +252,7 @@ impl AreaLight {
     /// `part` from `origin`; 0 if `p` faces away. (A sphere seen from
     /// outside is only ever seen, and sampled, on its front cap, so its
     /// density does not depend on the rounding of `n` at the silhouette.)
-    #[inline]
+    #[inline(always)]
     fn pdf(&self, part: usize, origin: Vec3, p: Vec3, n: Vec3) -> f32 {
         match self.parts[part] {
             Part::Sphere(centre, r) => {

@@ -84,7 +84,7 @@ impl Rectangle {
     /// Whether `origin` is on the emitting side and near enough for
     /// solid-angle sampling (the cheap first test of [`Self::spherical`]).
     #[inline(always)]
-    pub fn is_near(&self, origin: Vec3) -> bool {
+    fn is_near(&self, origin: Vec3) -> bool {
         self.n.dot(origin - self.corner) > 0.0
             && (self.centre - origin).length_squared() <= NEAR * self.area
     }
@@ -92,11 +92,17 @@ impl Rectangle {
     /// The rectangle as seen from `origin` for solid-angle sampling, if
     /// `origin` is near it on its emitting side and the solid angle is
     /// within the reliable range.
-    #[inline]
+    #[inline(always)]
     pub fn spherical(&self, origin: Vec3) -> Option<SphericalRectangle> {
         if !self.is_near(origin) {
             return None;
         }
+        self.spherical_near(origin)
+    }
+
+    /// [`Self::spherical`] past its first test: the construction, out of
+    /// line, so that the far points' cheap test stays in its caller's loop.
+    fn spherical_near(&self, origin: Vec3) -> Option<SphericalRectangle> {
         SphericalRectangle::new(origin, self.corner, self.ex, self.ey)
             .filter(|s| (MIN_SOLID_ANGLE..MAX_SOLID_ANGLE).contains(&s.solid_angle))
     }
