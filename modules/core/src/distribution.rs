@@ -45,7 +45,8 @@ impl Distribution1D {
             cdf.push(acc as f32);
         }
         cdf[n] = 1.0;
-        let g = n.next_power_of_two();
+        // At most 2^24 steps, so that every k / g is exact in f32.
+        let g = n.next_power_of_two().min(1 << 24);
         let mut guide: Vec<u32> = (0..g)
             .map(|k| cdf.partition_point(|&c| c <= k as f32 / g as f32) as u32)
             .collect();
