@@ -1013,10 +1013,14 @@ impl Wavefront {
         base: u32,
     ) {
         let n = self.live.len();
-        fit(&mut self.u1, n);
-        sampler.fill_1d(&self.ids_k, base + 6, &mut self.u1);
         let rr_depth = scene.settings.rr_depth;
         let rr_all = depth + 1 >= rr_depth;
+        fit(&mut self.u1, n);
+        if rr_all || per_path {
+            // Russian roulette's samples; before `rr_depth` nothing reads
+            // them.
+            sampler.fill_1d(&self.ids_k, base + 6, &mut self.u1);
+        }
         let depths = per_path.then(|| self.media.depth());
         fit(&mut self.next_live, n);
         // Slices taken once (bounds in registers); survivors written by
