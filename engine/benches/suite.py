@@ -479,14 +479,31 @@ def cmd_write(_args):
     return 0
 
 
-def setup_mitsuba(threads):
+# What Dr.Jit's LLVM backend compiles for with `--mitsuba-isa avx2`: an
+# AVX2-only CPU (Haswell and later, Zen 1-3), eight lanes.
+AVX2_TARGET = (b"haswell", b"+avx2,+fma,+f16c,+bmi,+bmi2,+lzcnt,+popcnt,+sse4.2,"
+               b"-avx512f,-avx512vl,-avx512dq,-avx512bw,-avx512cd", 8)
+
+
+def setup_mitsuba(threads, isa="native"):
     if "DRJIT_LIBLLVM_PATH" not in os.environ and find_libllvm():
         os.environ["DRJIT_LIBLLVM_PATH"] = find_libllvm()
     import mitsuba as mi
     mi.set_variant("llvm_ad_rgb")
+    import drjit as dr
     if threads:
-        import drjit as dr
         dr.set_thread_count(threads)
+    if isa == "avx2":
+        # Dr.Jit's C++ `jit_llvm_set_target(cpu, features, vector_width)`,
+        # which its Python module does not expose: kernels compiled after
+        # it target an AVX2-only CPU, as on such a host.
+        import ctypes
+        import glob
+        core = ctypes.CDLL(glob.glob(os.path.join(os.path.dirname(dr.__file__),
+                                                  "libdrjit-core.so"))[0])
+        set_target = core._Z19jit_llvm_set_targetPKcS0_j
+        set_target.argtypes = [ctypes.c_char_p, ctypes.c_char_p, ctypes.c_uint32]
+        set_target(*AVX2_TARGET)
     return mi
 
 
@@ -602,7 +619,7 @@ def scene_variant(yaml, selection="", sampler=""):
 def cmd_bench(args):
     import numpy as np
     import drjit as dr
-    mi = setup_mitsuba(args.threads)
+    mi = setup_mitsuba(args.threads, args.mitsuba_isa)
     extra = args.radiant_args.split() if args.radiant_args else []
     rows = []
     for name, s in selected(args).items():
@@ -645,7 +662,8 @@ def cmd_bench(args):
           f"interleaved runs; {cpu_summary()}"
           + (f"; Radiant with light_selection: {args.light_selection}" if args.light_selection else "")
           + (f"; Radiant's sampler: {args.sampler}" if args.sampler else "")
-          + f"; Mitsuba's sampler: {args.mitsuba_sampler}")
+          + f"; Mitsuba's sampler: {args.mitsuba_sampler}"
+          + (f"; Mitsuba compiled for {args.mitsuba_isa}" if args.mitsuba_isa != "native" else ""))
     print("| scene | spp | Radiant s | Mitsuba s | speed | MSE Radiant | MSE Mitsuba | at equal error |")
     print("|---|---|---|---|---|---|---|---|")
     speeds, equal = [], []
@@ -746,6 +764,10 @@ def main():
     b.add_argument("--mitsuba-sampler", default="independent",
                    help="Mitsuba's sampler (independent, its default; or ldsampler, multijitter, "
                         "orthogonal, stratified)")
+    b.add_argument("--mitsuba-isa", default="native", choices=["native", "avx2"],
+                   help="the instruction set Mitsuba's kernels are compiled for: the host's "
+                        "(native), or an AVX2-only CPU's, eight lanes (avx2), to stand in for "
+                        "such a host")
     b.add_argument("--radiant-args", default="",
                    help="extra arguments for radiant render (one string)")
     pr = sub.add_parser("profile", help="perf profile of each scene on one thread")
