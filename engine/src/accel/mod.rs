@@ -307,7 +307,7 @@ impl Accel {
     /// The primitive `hit` found, in its bottom level's space at shutter
     /// time `tau`, with the instance's placement there (`None`: the
     /// primitive is in render space).
-    #[inline]
+    #[inline(always)]
     pub fn primitive(&self, hit: &Hit, tau: f32) -> (Primitive, Option<Placement>) {
         if self.direct {
             return (self.blases[0].primitive(hit.prim as usize, tau), None);
