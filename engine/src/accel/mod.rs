@@ -13,7 +13,10 @@
 //! its base), so a hit's primitive addresses the shading arrays directly.
 //!
 //! Both levels are 8-wide BVHs collapsed from obvhs' binary ones
-//! ([`hierarchy`]). Triangles use the watertight test of Woop et al. 2013.
+//! ([`hierarchy`]). Queries run the traversal compiled for the best
+//! instruction set the CPU has, chosen once per accelerator (`Level`: the
+//! baseline, AVX2, or the AVX2 code compiled with AVX-512 F and VL
+//! enabled, whose 32 vector registers spill less). Triangles use the watertight test of Woop et al. 2013.
 //! Spawned rays start at origins offset by a conservative bound on the hit
 //! point's floating-point error ([`offset`]), which keeps self-intersection
 //! away at every scene scale without a fixed epsilon; instance transforms
