@@ -316,13 +316,10 @@ impl Accel {
                     Place::Fixed(p) => (EntryKind::Fixed, p.to_object),
                     Place::Moving(_) => (EntryKind::Moving, glam::Affine3A::IDENTITY),
                 };
-                TopEntry {
+                TopEntry::new(
                     to_object,
-                    inst: i,
-                    blas: inst.blas,
-                    base: bases[inst.blas as usize],
-                    kind,
-                }
+                    [i, inst.blas, bases[inst.blas as usize], kind as u32],
+                )
             })
             .collect();
     }
@@ -598,17 +595,72 @@ enum EntryKind {
     Moving,
 }
 
-/// An instance as top-level traversal reads it.
+/// An instance as top-level traversal reads it: one cache line, the
+/// render-to-object transform's columns (for [`EntryKind::Fixed`]) with
+/// the instance, its bottom level, that level's first primitive number
+/// and the [`EntryKind`] in their fourth lanes. Those lanes are stored as
+/// `bits ^ ONE_BITS`, normal floats for any count below 2²³, so that the
+/// transform's arithmetic, which computes them and throws them away,
+/// never meets a subnormal (slow on Intel CPUs).
 #[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
 struct TopEntry {
+    cols: [glam::Vec4; 4],
+}
+
+/// The bits of 1.0, which [`TopEntry`]'s fourth lanes are XORed with.
+const ONE_BITS: u32 = 0x3F80_0000;
+
+impl TopEntry {
+    /// The entry of transform `to_object` and `words`: instance, bottom
+    /// level, first primitive number and kind.
+    fn new(to_object: glam::Affine3A, words: [u32; 4]) -> Self {
+        let m = to_object.matrix3;
+        let columns = [m.x_axis, m.y_axis, m.z_axis, to_object.translation];
+        Self {
+            cols: std::array::from_fn(|i| columns[i].extend(f32::from_bits(words[i] ^ ONE_BITS))),
+        }
+    }
+
     /// Render space to object space (for [`EntryKind::Fixed`]).
-    to_object: glam::Affine3A,
+    #[inline(always)]
+    fn transform(&self) -> glam::Affine3A {
+        let [x, y, z, w] = self.cols.map(Vec3A::from_vec4);
+        glam::Affine3A::from_cols(x, y, z, w)
+    }
+
+    #[inline(always)]
+    fn word(&self, i: usize) -> u32 {
+        self.cols[i].w.to_bits() ^ ONE_BITS
+    }
+
     /// The instance.
-    inst: u32,
-    /// Its bottom level, and that level's first primitive number.
-    blas: u32,
-    base: u32,
-    kind: EntryKind,
+    #[inline(always)]
+    fn inst(&self) -> u32 {
+        self.word(0)
+    }
+
+    /// Its bottom level.
+    #[inline(always)]
+    fn blas(&self) -> u32 {
+        self.word(1)
+    }
+
+    /// That level's first primitive number.
+    #[inline(always)]
+    fn base(&self) -> u32 {
+        self.word(2)
+    }
+
+    /// How a ray enters it.
+    #[inline(always)]
+    fn kind(&self) -> EntryKind {
+        match self.word(3) {
+            0 => EntryKind::Identity,
+            1 => EntryKind::Fixed,
+            _ => EntryKind::Moving,
+        }
+    }
 }
 
 /// One ray's query of the top level: at each leaf, the ray enters each
@@ -628,14 +680,14 @@ impl<I: Isa> TopQuery<'_, I> {
     /// the instance cannot be entered (a singular transform).
     #[inline(always)]
     fn enter(&self, entry: &TopEntry) -> Option<(Vec3, Vec3, f32)> {
-        match entry.kind {
+        match entry.kind() {
             EntryKind::Identity => Some((self.origin, self.dir, 0.0)),
             EntryKind::Fixed => Some(instance::ray_to_object(
-                &entry.to_object,
+                &entry.transform(),
                 self.origin,
                 self.dir,
             )),
-            EntryKind::Moving => match &self.accel.instances[entry.inst as usize].place {
+            EntryKind::Moving => match &self.accel.instances[entry.inst() as usize].place {
                 Place::Moving(m) => Some(m.at(self.tau)?.ray_to_object(self.origin, self.dir)),
                 _ => None,
             },
@@ -651,13 +703,13 @@ impl<I: Isa> LeafVisitor for TopQuery<'_, I> {
             let Some((o, d, dt)) = self.enter(entry) else {
                 continue;
             };
-            let blas = &accel.blases[entry.blas as usize];
-            let hit = blas.closest::<I>(o, d, tmax - dt, self.tau, entry.base);
+            let blas = &accel.blases[entry.blas() as usize];
+            let hit = blas.closest::<I>(o, d, tmax - dt, self.tau, entry.base());
             if hit.prim != Hit::MISS.prim {
                 tmax = hit.t + dt;
                 self.best = Hit {
                     t: tmax,
-                    inst: entry.inst,
+                    inst: entry.inst(),
                     ..hit
                 };
             }
@@ -672,7 +724,7 @@ impl<I: Isa> LeafVisitor for TopQuery<'_, I> {
             let Some((o, d, dt)) = self.enter(entry) else {
                 continue;
             };
-            if accel.blases[entry.blas as usize].any::<I>(o, d, tmax - dt, self.tau) {
+            if accel.blases[entry.blas() as usize].any::<I>(o, d, tmax - dt, self.tau) {
                 return true;
             }
         }
