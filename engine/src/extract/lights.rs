@@ -231,16 +231,22 @@ impl LightTable {
             let slot = self.slot_of[i] as usize;
             pmf[k] = match weights {
                 Some(w) if slot < self.bounded.len() => {
-                    let total = positive_sum(&w[..self.bounded.len()]);
-                    if total > 0.0 {
-                        (1.0 - self.p_unbounded) * w[slot] / total
-                    } else {
-                        0.0
-                    }
+                    self.pmf_bounded(w, positive_sum(&w[..self.bounded.len()]), slot)
                 }
                 _ => self.pmf_at(points[k], i),
             };
         });
+    }
+
+    /// The probability that [`pick_bounded`](Self::pick_bounded) picks
+    /// the bounded light in `slot` given the same `weights` and `total`.
+    #[inline]
+    fn pmf_bounded(&self, weights: &[f32], total: f32, slot: usize) -> f32 {
+        if total > 0.0 {
+            (1.0 - self.p_unbounded) * weights[slot] / total
+        } else {
+            0.0
+        }
     }
 
     /// Calls `visit(k, weights)` for each of `points` in order, with the
@@ -307,11 +313,7 @@ impl LightTable {
                 return share * tree.pmf(p, slot);
             }
             let (weights, total) = self.importances(p);
-            return if total > 0.0 {
-                share * weights[slot] / total
-            } else {
-                0.0
-            };
+            return self.pmf_bounded(&weights, total, slot);
         }
         if self.unbounded.contains(&(i as u32)) {
             self.p_unbounded / self.unbounded.len() as f32

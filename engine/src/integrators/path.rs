@@ -112,7 +112,9 @@ pub struct Wavefront {
     light: Vec<u32>,
     light_prob: Vec<f32>,
     light_sample: Vec<LightSample>,
-    /// The live paths' shading points, in `live`'s order.
+    /// Points handed to the light table: the live paths' shading points
+    /// (in `live`'s order) when choosing lights, the emitter hits' ray
+    /// origins when weighing those hits.
     points: Vec<Vec3>,
     // Grouping by light.
     by_light: Vec<u32>,
