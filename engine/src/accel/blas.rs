@@ -8,6 +8,7 @@
 //! at each ray's time.
 
 use super::hierarchy::{Hierarchy, Update, UpdatePolicy};
+use super::huge::HugeArray;
 use super::sphere::Sphere4;
 use super::triangle::{RayPrep, Tri4};
 use super::wide::{Isa, LeafCost, LeafVisitor, RayBoxes};
@@ -43,16 +44,16 @@ impl Packet {
 /// shutter is open.
 #[derive(Clone)]
 struct Closing {
-    packets: Vec<Packet>,
-    prims: Vec<Primitive>,
+    packets: HugeArray<Packet>,
+    prims: HugeArray<Primitive>,
 }
 
 /// A bottom-level hierarchy and its primitives in leaf order.
 #[derive(Clone, Default)]
 pub struct Blas {
     hierarchy: Hierarchy,
-    packets: Vec<Packet>,
-    prims: Vec<Primitive>,
+    packets: HugeArray<Packet>,
+    prims: HugeArray<Primitive>,
     closing: Option<Closing>,
     /// Per leaf-order index, the index of the primitive in the input.
     order: Vec<u32>,
@@ -124,13 +125,13 @@ impl Blas {
 
     fn rebuild(&mut self, prims: &[Primitive], close: Option<&[Primitive]>, quality: BuildQuality) {
         let boxes = boxes(prims, close);
-        let (mut order, mut packets) = (Vec::with_capacity(prims.len()), Vec::new());
+        let (mut order, mut packets) = (Vec::with_capacity(prims.len()), packet_room(prims));
         let hierarchy = Hierarchy::build(&boxes, quality, LeafCost::PACKETS, |leaf| {
             store_leaf(leaf, prims, &mut order, &mut packets)
         });
         debug_assert_eq!(order.len(), prims.len());
         self.hierarchy = hierarchy;
-        self.prims = order.iter().map(|&i| prims[i as usize]).collect();
+        self.prims = HugeArray::from_fn(order.len(), |k| prims[order[k] as usize]);
         self.closing = close.map(|close| closing(close, &order, &packets));
         self.packets = packets;
         self.order = order;
@@ -156,7 +157,7 @@ impl Blas {
         assert_eq!(prims.len(), self.order.len(), "the primitive count changed");
         let start = std::time::Instant::now();
         let boxes = boxes(prims, close);
-        let (mut order, mut packets) = (Vec::new(), Vec::new());
+        let (mut order, mut packets) = (Vec::new(), packet_room(prims));
         let update = self.hierarchy.update(&boxes, policy, |leaf| {
             store_leaf(leaf, prims, &mut order, &mut packets)
         });
@@ -168,11 +169,12 @@ impl Blas {
             // Same leaves, same order: repack the moved triangles.
             repack(&mut self.packets, prims, &self.order);
         }
-        self.order
-            .par_iter()
+        // The same number of primitives (asserted above): in place.
+        self.prims
+            .par_iter_mut()
+            .zip(&self.order)
             .with_min_len(4096)
-            .map(|&i| prims[i as usize])
-            .collect_into_vec(&mut self.prims);
+            .for_each(|(p, &i)| *p = prims[i as usize]);
         self.closing = close.map(|close| closing(close, &self.order, &self.packets));
         self.version = next_version();
         Update {
@@ -351,13 +353,19 @@ fn boxes(prims: &[Primitive], close: Option<&[Primitive]>) -> Vec<Option<Aabb>> 
     }
 }
 
+/// Room for the packets of `prims`: at most one per primitive (address
+/// space only; the packets written take memory).
+fn packet_room(prims: &[Primitive]) -> HugeArray<Packet> {
+    HugeArray::with_capacity(prims.len())
+}
+
 /// Stores one leaf of input primitives `leaf`: triangles first, then
 /// spheres, in packets of four; returns its range of packets.
 fn store_leaf(
     leaf: &[u32],
     prims: &[Primitive],
     order: &mut Vec<u32>,
-    packets: &mut Vec<Packet>,
+    packets: &mut HugeArray<Packet>,
 ) -> Range<u32> {
     let start = packets.len() as u32;
     let (tris, spheres): (Vec<u32>, Vec<u32>) = leaf
@@ -431,11 +439,11 @@ fn repack(packets: &mut [Packet], prims: &[Primitive], order: &[u32]) {
 /// The packets of the shapes at shutter close `close` (input order),
 /// laid out as the packets at shutter open, `open`.
 fn closing(close: &[Primitive], order: &[u32], open: &[Packet]) -> Closing {
-    let mut packets = open.to_vec();
+    let mut packets = HugeArray::from_slice(open);
     repack(&mut packets, close, order);
     Closing {
         packets,
-        prims: order.iter().map(|&i| close[i as usize]).collect(),
+        prims: HugeArray::from_fn(order.len(), |k| close[order[k] as usize]),
     }
 }
 

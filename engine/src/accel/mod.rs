@@ -24,8 +24,10 @@
 
 mod blas;
 pub mod hierarchy;
+mod huge;
 pub mod instance;
 pub mod offset;
+pub mod prefetch;
 pub mod sphere;
 pub mod triangle;
 mod wide;
@@ -37,6 +39,7 @@ pub use instance::{Motion, Placement};
 
 use glam::{Vec3, Vec3A};
 use hierarchy::Hierarchy;
+use huge::HugeArray;
 use obvhs::aabb::Aabb;
 use std::marker::PhantomData;
 use std::ops::Range;
@@ -125,7 +128,7 @@ pub struct Accel {
     tlas_items: Vec<u32>,
     /// What traversal needs of each instance, in the top level's leaf order
     /// (instances a ray meets one after the other lie side by side).
-    tlas_entries: Vec<TopEntry>,
+    tlas_entries: HugeArray<TopEntry>,
     /// Whether queries go straight to instance 0 (one instance, no
     /// placement).
     direct: bool,
@@ -241,7 +244,7 @@ impl Accel {
             instances,
             tlas: Hierarchy::default(),
             tlas_items: Vec::new(),
-            tlas_entries: Vec::new(),
+            tlas_entries: HugeArray::default(),
             direct,
             quality,
             level: Level::detected(),
@@ -306,22 +309,20 @@ impl Accel {
     /// Writes the traversal entries in leaf order.
     fn lay_out_entries(&mut self) {
         let (instances, bases) = (&self.instances, &self.bases);
-        self.tlas_entries = self
-            .tlas_items
-            .iter()
-            .map(|&i| {
-                let inst = &instances[i as usize];
-                let (kind, to_object) = match &inst.place {
-                    Place::Identity => (EntryKind::Identity, glam::Affine3A::IDENTITY),
-                    Place::Fixed(p) => (EntryKind::Fixed, p.to_object),
-                    Place::Moving(_) => (EntryKind::Moving, glam::Affine3A::IDENTITY),
-                };
-                TopEntry::new(
-                    to_object,
-                    [i, inst.blas, bases[inst.blas as usize], kind as u32],
-                )
-            })
-            .collect();
+        let items = &self.tlas_items;
+        self.tlas_entries = HugeArray::from_fn(items.len(), |k| {
+            let i = items[k];
+            let inst = &instances[i as usize];
+            let (kind, to_object) = match &inst.place {
+                Place::Identity => (EntryKind::Identity, glam::Affine3A::IDENTITY),
+                Place::Fixed(p) => (EntryKind::Fixed, p.to_object),
+                Place::Moving(_) => (EntryKind::Moving, glam::Affine3A::IDENTITY),
+            };
+            TopEntry::new(
+                to_object,
+                [i, inst.blas, bases[inst.blas as usize], kind as u32],
+            )
+        });
     }
 
     /// Updates the top level after instances moved ([`Accel::instances_mut`])
@@ -388,6 +389,41 @@ impl Accel {
         let local = (hit.prim - self.bases[blas]) as usize;
         let prim = self.blases[blas].primitive(local, tau);
         (prim, inst.place.at(tau))
+    }
+
+    /// Starts loading the record of `hit`'s instance (its placement) into
+    /// the cache; does nothing for a miss or where there are no placed
+    /// instances. With thousands of instances the records are rarely
+    /// cached, so batch stages ask a few hits ahead of resolving them, and
+    /// [`Accel::prefetch_primitive`] reads the record later.
+    #[inline(always)]
+    pub fn prefetch_instance(&self, hit: &Hit) {
+        if let (false, Some(inst)) = (self.direct, self.instances.get(hit.inst as usize)) {
+            prefetch::prefetch(inst);
+        }
+    }
+
+    /// Starts loading `hit`'s primitive, which [`Accel::primitive`] reads,
+    /// into the cache; does nothing for a miss. It reads the instance's
+    /// record: ask [`Accel::prefetch_instance`] for it a few hits earlier.
+    #[inline(always)]
+    pub fn prefetch_primitive(&self, hit: &Hit) {
+        let (blas, local) = if self.direct {
+            (0, hit.prim)
+        } else {
+            let Some(inst) = self.instances.get(hit.inst as usize) else {
+                return;
+            };
+            let blas = inst.blas as usize;
+            (blas, hit.prim.wrapping_sub(self.bases[blas]))
+        };
+        if let Some(prim) = self
+            .blases
+            .get(blas)
+            .and_then(|b| b.primitives().get(local as usize))
+        {
+            prefetch::prefetch(prim);
+        }
     }
 
     /// Finds the closest hit along `origin + t·dir` for `t` in (0, `tmax`).

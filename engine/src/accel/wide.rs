@@ -21,6 +21,7 @@
 //! so a box never misses a ray that touches it, flat boxes (axis-aligned
 //! triangles) included.
 
+use super::huge::HugeArray;
 use glam::{Vec3, Vec3A, Vec4};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
@@ -559,7 +560,7 @@ pub trait LeafVisitor {
 /// A wide BVH; its leaves are ranges of items stored elsewhere.
 #[derive(Debug, Clone, Default)]
 pub struct WideBvh {
-    nodes: Vec<Node>,
+    nodes: HugeArray<Node>,
     /// Per node and lane: the binary node the lane was collapsed from
     /// ([`NO_SOURCE`] for an unused lane), so that a refitted binary BVH
     /// can hand its boxes to the wide one ([`WideBvh::refit`]).
@@ -621,7 +622,10 @@ impl WideBvh {
         if bvh2.nodes[0].is_leaf() {
             // A single leaf: one lane of the root holds it.
             make_leaf(&mut nodes[0], &mut sources[0][0], 0, 0);
-            return Self { nodes, sources };
+            return Self {
+                nodes: nodes.into(),
+                sources,
+            };
         }
         // (binary node, wide node it becomes, depth of that wide node)
         let mut work = vec![(0, 0, 1)];
@@ -642,7 +646,10 @@ impl WideBvh {
                 }
             }
         }
-        Self { nodes, sources }
+        Self {
+            nodes: nodes.into(),
+            sources,
+        }
     }
 
     /// Takes the boxes of `bvh2` — the binary BVH this one was collapsed
@@ -679,7 +686,7 @@ impl WideBvh {
             return 0.0;
         }
         let mut total = root_area * NODE_COST;
-        for node in &self.nodes {
+        for node in self.nodes.iter() {
             for lane in 0..WIDTH {
                 let Some(aabb) = node.lane_box(lane) else {
                     continue;

@@ -20,7 +20,9 @@
 
 use super::medium::{self, MEDIUM_DIMS, MediumState};
 use super::sort::sort_by_key;
-use super::surface::{Derivatives, Interaction, interaction, interaction_with_derivatives};
+use super::surface::{
+    self, Derivatives, Interaction, PREFETCH_AHEAD, interaction, interaction_with_derivatives,
+};
 use crate::accel::offset::{offset_origin, sampled_point_error};
 use crate::accel::{Hit, Motion};
 use crate::extract::{NO_EMITTER, RenderScene};
@@ -584,7 +586,13 @@ impl Wavefront {
         let time = &self.time[..];
         let blur = scene.motion_blur();
         let (mut m, mut em, mut esc) = (0, 0, 0);
-        for &slot in live {
+        let ahead = |k: usize| live.get(k).map(|&s| &hits[s as usize]);
+        for (k, &slot) in live.iter().enumerate() {
+            surface::prefetch(
+                scene,
+                ahead(k + 2 * PREFETCH_AHEAD),
+                ahead(k + PREFETCH_AHEAD),
+            );
             let i = slot as usize;
             let hit = hits[i];
             if hit.prim == Hit::MISS.prim {

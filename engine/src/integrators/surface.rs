@@ -70,6 +70,34 @@ fn above_tangent_plane(ns: Vec3, ng: Vec3) -> Vec3 {
     }
 }
 
+/// Hits ahead of the one being resolved whose records [`prefetch`] asks
+/// for: far enough that a miss to memory is over when the hit's turn
+/// comes, near enough that the lines are still cached then.
+pub const PREFETCH_AHEAD: usize = 8;
+
+/// Starts loading what resolving `hit` reads, in two steps: `far` is hit
+/// 2 × [`PREFETCH_AHEAD`] ahead, whose instance record is asked for;
+/// `near` is [`PREFETCH_AHEAD`] ahead, whose primitive (addressed through
+/// that record) and shading records are. A batch stage calls this once
+/// per hit it resolves; misses (and `None`) are skipped.
+#[inline(always)]
+pub fn prefetch(scene: &RenderScene, far: Option<&Hit>, near: Option<&Hit>) {
+    use crate::accel::prefetch::prefetch;
+    if let Some(hit) = far {
+        scene.accel.prefetch_instance(hit);
+    }
+    let Some(hit) = near else { return };
+    scene.accel.prefetch_primitive(hit);
+    let i = hit.prim as usize;
+    let surfaces = &scene.surfaces;
+    if let Some(n) = surfaces.normals.get(i) {
+        prefetch(n);
+    }
+    if let Some(f) = surfaces.face_frames.get(i) {
+        prefetch(f);
+    }
+}
+
 /// Resolves `hit` of the ray `origin + t·dir` at shutter time `tau`, with
 /// a shading frame whose tangent is arbitrary.
 #[inline]

@@ -1,0 +1,39 @@
+//! Software prefetch: starting the loads of data that a batch stage will
+//! read a few items later.
+//!
+//! The wavefront resolves a batch of hits one after the other, and each
+//! hit reads records (its primitive, its instance's placement, its vertex
+//! normals) at places in memory that no hardware prefetcher can guess. The
+//! addresses are known from the batch's hit array long before they are
+//! needed, so a stage asks for them a few hits ahead
+//! ([`crate::accel::Accel::prefetch_instance`],
+//! [`crate::accel::Accel::prefetch_primitive`]), and the misses overlap
+//! instead of stalling one by one.
+
+/// Bytes per cache line.
+const LINE: usize = 64;
+
+/// Starts loading every cache line of `value` into the first-level data
+/// cache, without waiting for it (a hint: it changes no result, and does
+/// nothing on targets without a prefetch instruction).
+#[inline(always)]
+pub fn prefetch<T>(value: &T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let start = std::ptr::from_ref(value).cast::<i8>();
+        let size = std::mem::size_of::<T>();
+        // The first line, and one per line boundary the value crosses.
+        let skew = start as usize % LINE;
+        let mut offset = 0;
+        while offset < size + skew {
+            // A prefetch never faults, so the last address may lie past
+            // the value's end (in its last line).
+            // SAFETY: prefetching reads nothing and never faults.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(offset)) };
+            offset += LINE;
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = value;
+}
