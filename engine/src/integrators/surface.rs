@@ -139,9 +139,16 @@ fn resolve<const TANGENTS: bool>(
     let Some(place) = placement else {
         return local_interaction::<TANGENTS>(scene, prim, hit, origin, dir, None);
     };
-    // In the instance's space (the ray as the query saw it), then out to
-    // render space with the transform's rounding error.
-    let (o, d, _) = place.ray_to_object(origin, dir);
+    // In the instance's space (the ray as the query saw it: only a
+    // sphere's hit point reads it), then out to render space with the
+    // transform's rounding error.
+    let (o, d) = match prim {
+        Primitive::Sphere(..) => {
+            let (o, d, _) = place.ray_to_object(origin, dir);
+            (o, d)
+        }
+        Primitive::Triangle(_) => (origin, dir),
+    };
     let (it, dp) = local_interaction::<TANGENTS>(scene, prim, hit, o, d, Some(&place));
     let (p, err) = place.point_to_render(it.p, it.err);
     let ng = place.normal_to_render(it.ng);
