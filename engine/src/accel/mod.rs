@@ -426,6 +426,18 @@ impl Accel {
         }
     }
 
+    /// Whether `hit`'s primitive lies in render space as stored (no
+    /// placement moves it): then the shading records made in render space
+    /// (face frames) serve it. Reads the instance's record.
+    #[inline(always)]
+    pub fn in_render_space(&self, hit: &Hit) -> bool {
+        self.direct
+            || self
+                .instances
+                .get(hit.inst as usize)
+                .is_some_and(|inst| matches!(inst.place, Place::Identity))
+    }
+
     /// Finds the closest hit along `origin + t·dir` for `t` in (0, `tmax`).
     #[inline]
     pub fn intersect(&self, origin: Vec3, dir: Vec3, tmax: f32) -> Option<Hit> {

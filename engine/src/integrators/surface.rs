@@ -93,7 +93,9 @@ pub fn prefetch(scene: &RenderScene, far: Option<&Hit>, near: Option<&Hit>) {
     if let Some(n) = surfaces.normals.get(i) {
         prefetch(n);
     }
-    if let Some(f) = surfaces.face_frames.get(i) {
+    if let Some(f) = surfaces.face_frames.get(i)
+        && scene.accel.in_render_space(hit)
+    {
         prefetch(f);
     }
 }
