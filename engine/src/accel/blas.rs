@@ -241,7 +241,7 @@ impl Blas {
 
     /// Primitive `i` (leaf order) at shutter time `tau` (triangles of a
     /// deforming mesh are interpolated vertex by vertex).
-    #[inline]
+    #[inline(always)]
     pub fn primitive(&self, i: usize, tau: f32) -> Primitive {
         match (&self.closing, self.prims[i]) {
             (Some(c), Primitive::Triangle(a)) => match c.prims[i] {

@@ -18,6 +18,7 @@
 
 use std::fmt;
 use std::ops::{Deref, DerefMut};
+use std::ptr::NonNull;
 
 /// The huge page size (x86-64 and AArch64 with 4 KiB base pages), and the
 /// least array size that is mapped on its own.
@@ -28,27 +29,47 @@ const HUGE_PAGE: usize = 2 << 20;
 /// grows only up to the capacity it was made with (beyond, it moves to
 /// the heap).
 pub struct HugeArray<T: Copy> {
+    /// The first value (dangling while nothing was ever stored), so that
+    /// reading the array is one pointer and one length, whatever holds it.
+    first: NonNull<T>,
+    len: usize,
     storage: Storage<T>,
 }
 
+/// What holds a [`HugeArray`]'s values.
 enum Storage<T> {
     /// Below [`HUGE_PAGE`] (or where mapping failed, or the capacity was
-    /// exceeded).
+    /// exceeded): a `Vec` as long as the array.
     Heap(Vec<T>),
-    /// `len` values from byte `start` of `map` on, a huge page boundary,
-    /// with room for `capacity`. Pages beyond the values are never
-    /// touched, so they take no memory.
+    /// A mapping with room for `capacity` values from a huge page
+    /// boundary on. Pages beyond the values are never touched, so they
+    /// take no memory.
     Mapped {
-        map: memmap2::MmapMut,
-        start: usize,
-        len: usize,
+        /// Held for its drop, which unmaps it; read through `first`.
+        _map: memmap2::MmapMut,
         capacity: usize,
     },
 }
 
+// SAFETY: a `HugeArray` owns its values as a `Vec` would (the pointer is
+// into its own storage), so it may move to and be shared between threads
+// as a `Vec<T>` can.
+unsafe impl<T: Copy + Send> Send for HugeArray<T> {}
+// SAFETY: as above.
+unsafe impl<T: Copy + Sync> Sync for HugeArray<T> {}
+
 impl<T: Copy> HugeArray<T> {
     // A huge page boundary is aligned for any `T` that can be.
     const ALIGNED: () = assert!(std::mem::align_of::<T>() <= HUGE_PAGE);
+
+    /// The array held by `values`.
+    fn on_heap(mut values: Vec<T>) -> Self {
+        Self {
+            first: NonNull::new(values.as_mut_ptr()).unwrap_or(NonNull::dangling()),
+            len: values.len(),
+            storage: Storage::Heap(values),
+        }
+    }
 
     /// An empty array with room for `capacity` values, in huge pages if
     /// they would take at least 2 MiB. Only the memory that values are
@@ -57,46 +78,42 @@ impl<T: Copy> HugeArray<T> {
         let () = Self::ALIGNED;
         let bytes = capacity.saturating_mul(std::mem::size_of::<T>());
         if bytes >= HUGE_PAGE
-            && let Some((map, start)) = map_huge(bytes)
+            && let Some((mut map, start)) = map_huge(bytes)
         {
+            // SAFETY: `start` lies inside the mapping (`map_huge`).
+            let first = unsafe { map.as_mut_ptr().add(start) }.cast::<T>();
             return Self {
+                first: NonNull::new(first).unwrap_or(NonNull::dangling()),
+                len: 0,
                 storage: Storage::Mapped {
-                    map,
-                    start,
-                    len: 0,
+                    _map: map,
                     capacity,
                 },
             };
         }
-        Self {
-            storage: Storage::Heap(Vec::with_capacity(capacity)),
-        }
+        Self::on_heap(Vec::with_capacity(capacity))
     }
 
     /// Appends `value`.
     #[inline]
     pub fn push(&mut self, value: T) {
-        if let Storage::Mapped { len, capacity, .. } = self.storage
-            && len == capacity
+        if let Storage::Mapped { capacity, .. } = self.storage
+            && self.len == capacity
         {
-            self.storage = Storage::Heap(self.to_vec());
+            *self = Self::on_heap(self.to_vec());
         }
         match &mut self.storage {
-            Storage::Heap(values) => values.push(value),
-            Storage::Mapped {
-                map, start, len, ..
-            } => {
+            Storage::Mapped { .. } => {
                 // SAFETY: `len` is below the capacity (above), so the slot
                 // lies in the mapping's room for `capacity` values from
-                // `start` (a huge page boundary, aligned for `T`).
-                unsafe {
-                    map.as_mut_ptr()
-                        .add(*start)
-                        .cast::<T>()
-                        .add(*len)
-                        .write(value)
-                };
-                *len += 1;
+                // `first` (a huge page boundary, aligned for `T`).
+                unsafe { self.first.add(self.len).write(value) };
+                self.len += 1;
+            }
+            Storage::Heap(values) => {
+                values.push(value);
+                self.first = NonNull::new(values.as_mut_ptr()).unwrap_or(NonNull::dangling());
+                self.len = values.len();
             }
         }
     }
@@ -137,29 +154,18 @@ impl<T: Copy> Deref for HugeArray<T> {
 
     #[inline(always)]
     fn deref(&self) -> &[T] {
-        match &self.storage {
-            Storage::Heap(values) => values,
-            // SAFETY: `push` wrote `len` valid values from `start` on, in
-            // the mapping, which lives as long as `self`.
-            Storage::Mapped {
-                map, start, len, ..
-            } => unsafe { std::slice::from_raw_parts(map.as_ptr().add(*start).cast::<T>(), *len) },
-        }
+        // SAFETY: `first` points at `len` values written into the storage,
+        // which lives as long as `self` and moves only through `&mut self`
+        // (which updates `first`); dangling only where `len` is 0.
+        unsafe { std::slice::from_raw_parts(self.first.as_ptr(), self.len) }
     }
 }
 
 impl<T: Copy> DerefMut for HugeArray<T> {
     #[inline(always)]
     fn deref_mut(&mut self) -> &mut [T] {
-        match &mut self.storage {
-            Storage::Heap(values) => values,
-            // SAFETY: as in `deref`, borrowed mutably through `self`.
-            Storage::Mapped {
-                map, start, len, ..
-            } => unsafe {
-                std::slice::from_raw_parts_mut(map.as_mut_ptr().add(*start).cast::<T>(), *len)
-            },
-        }
+        // SAFETY: as in `deref`, borrowed mutably through `self`.
+        unsafe { std::slice::from_raw_parts_mut(self.first.as_ptr(), self.len) }
     }
 }
 
@@ -170,18 +176,14 @@ impl<T: Copy> From<Vec<T>> for HugeArray<T> {
         if std::mem::size_of_val(values.as_slice()) >= HUGE_PAGE {
             Self::from_slice(&values)
         } else {
-            Self {
-                storage: Storage::Heap(values),
-            }
+            Self::on_heap(values)
         }
     }
 }
 
 impl<T: Copy> Default for HugeArray<T> {
     fn default() -> Self {
-        Self {
-            storage: Storage::Heap(Vec::new()),
-        }
+        Self::on_heap(Vec::new())
     }
 }
 

@@ -587,12 +587,15 @@ impl Wavefront {
         let blur = scene.motion_blur();
         let (mut m, mut em, mut esc) = (0, 0, 0);
         let ahead = |k: usize| live.get(k).map(|&s| &hits[s as usize]);
+        let prefetching = surface::prefetch_pays(scene);
         for (k, &slot) in live.iter().enumerate() {
-            surface::prefetch(
-                scene,
-                ahead(k + 2 * PREFETCH_AHEAD),
-                ahead(k + PREFETCH_AHEAD),
-            );
+            if prefetching {
+                surface::prefetch(
+                    scene,
+                    ahead(k + 2 * PREFETCH_AHEAD),
+                    ahead(k + PREFETCH_AHEAD),
+                );
+            }
             let i = slot as usize;
             let hit = hits[i];
             if hit.prim == Hit::MISS.prim {
