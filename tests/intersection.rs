@@ -36,7 +36,10 @@ fn cube(scale: f32, offset: Vec3) -> Vec<Primitive> {
 
 /// Hit point, error bound and geometric normal of a triangle hit.
 fn surface(accel: &Accel, hit: &Hit) -> (Vec3, Vec3, Vec3) {
-    let (Primitive::Triangle(v), None) = accel.primitive(hit, 0.0) else {
+    let (prim, None) = accel.primitive(hit, 0.0) else {
+        panic!("expected a primitive in render space")
+    };
+    let Primitive::Triangle(v) = *prim else {
         panic!("expected a triangle")
     };
     let b0 = 1.0 - hit.b1 - hit.b2;

@@ -78,7 +78,7 @@ fn light_pdf(
         return 0.0;
     };
     let p = origin + d * hit.t;
-    let hit_prim = shape.primitive(&hit, 0.0).0;
+    let hit_prim = *shape.primitive(&hit, 0.0).0;
     let n = match hit_prim {
         Primitive::Triangle(v) => (v[1] - v[0]).cross(v[2] - v[0]).normalize(),
         Primitive::Sphere(c, _) => (p - c).normalize(),

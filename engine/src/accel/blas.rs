@@ -17,6 +17,7 @@ use crate::settings::BuildQuality;
 use glam::{Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use rayon::prelude::*;
+use std::borrow::Cow;
 use std::ops::Range;
 
 /// What a leaf holds: triangles or spheres, four at a time.
@@ -241,16 +242,23 @@ impl Blas {
 
     /// Primitive `i` (leaf order) at shutter time `tau` (triangles of a
     /// deforming mesh are interpolated vertex by vertex).
+    ///
+    /// A static primitive is borrowed where it is stored, so that its
+    /// reader loads it from there: a copy on the stack, written a field at
+    /// a time and read back a vertex (16 bytes) at a time, would stall
+    /// each read until the writes retire.
     #[inline(always)]
-    pub fn primitive(&self, i: usize, tau: f32) -> Primitive {
-        match (&self.closing, self.prims[i]) {
+    pub fn primitive(&self, i: usize, tau: f32) -> Cow<'_, Primitive> {
+        match (&self.closing, &self.prims[i]) {
             (Some(c), Primitive::Triangle(a)) => match c.prims[i] {
                 Primitive::Triangle(b) => {
-                    Primitive::Triangle(std::array::from_fn(|k| a[k] + (b[k] - a[k]) * tau))
+                    Cow::Owned(Primitive::Triangle(std::array::from_fn(|k| {
+                        a[k] + (b[k] - a[k]) * tau
+                    })))
                 }
-                Primitive::Sphere(..) => self.prims[i],
+                Primitive::Sphere(..) => Cow::Borrowed(&self.prims[i]),
             },
-            (_, p) => p,
+            (_, p) => Cow::Borrowed(p),
         }
     }
 

@@ -41,6 +41,7 @@ use glam::{Vec3, Vec3A};
 use hierarchy::Hierarchy;
 use huge::HugeArray;
 use obvhs::aabb::Aabb;
+use std::borrow::Cow;
 use std::marker::PhantomData;
 use std::ops::Range;
 use std::time::{Duration, Instant};
@@ -380,7 +381,7 @@ impl Accel {
     /// time `tau`, with the instance's placement there (`None`: the
     /// primitive is in render space).
     #[inline(always)]
-    pub fn primitive(&self, hit: &Hit, tau: f32) -> (Primitive, Option<Placement>) {
+    pub fn primitive(&self, hit: &Hit, tau: f32) -> (Cow<'_, Primitive>, Option<Placement>) {
         if self.direct {
             return (self.blases[0].primitive(hit.prim as usize, tau), None);
         }

@@ -154,19 +154,19 @@ fn resolve<const TANGENTS: bool>(
 ) -> (Interaction, Derivatives) {
     let (prim, placement) = scene.accel.primitive(hit, tau);
     let Some(place) = placement else {
-        return local_interaction::<TANGENTS>(scene, prim, hit, origin, dir, None);
+        return local_interaction::<TANGENTS>(scene, &prim, hit, origin, dir, None);
     };
     // In the instance's space (the ray as the query saw it: only a
     // sphere's hit point reads it), then out to render space with the
     // transform's rounding error.
-    let (o, d) = match prim {
+    let (o, d) = match *prim {
         Primitive::Sphere(..) => {
             let (o, d, _) = place.ray_to_object(origin, dir);
             (o, d)
         }
         Primitive::Triangle(_) => (origin, dir),
     };
-    let (it, dp) = local_interaction::<TANGENTS>(scene, prim, hit, o, d, Some(&place));
+    let (it, dp) = local_interaction::<TANGENTS>(scene, &prim, hit, o, d, Some(&place));
     let (p, err) = place.point_to_render(it.p, it.err);
     let ng = place.normal_to_render(it.ng);
     let ns = place.normal_to_render(it.frame.n);
@@ -199,7 +199,7 @@ fn resolve<const TANGENTS: bool>(
 #[inline(always)]
 fn local_interaction<const TANGENTS: bool>(
     scene: &RenderScene,
-    prim: Primitive,
+    prim: &Primitive,
     hit: &Hit,
     origin: Vec3,
     dir: Vec3,
@@ -209,7 +209,7 @@ fn local_interaction<const TANGENTS: bool>(
     match prim {
         Primitive::Triangle(v) => {
             let b = [1.0 - hit.b1 - hit.b2, hit.b1, hit.b2];
-            let (p, err) = triangle_point(&v, b[0], b[1], b[2]);
+            let (p, err) = triangle_point(v, b[0], b[1], b[2]);
             let face = match placed {
                 None => scene.surfaces.face_frames[i],
                 Some(_) => Frame::from_normal((v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero()),
@@ -233,7 +233,7 @@ fn local_interaction<const TANGENTS: bool>(
                     .tangents
                     .get(i)
                     .map(|t| t[0] * b[0] + t[1] * b[1] + t[2] * b[2]);
-                triangle_frame(ns, &v, &uvs, tangent)
+                triangle_frame(ns, v, &uvs, tangent)
             } else {
                 (ns.map_or(face, Frame::from_normal), Derivatives::default())
             };
@@ -246,7 +246,7 @@ fn local_interaction<const TANGENTS: bool>(
             };
             (it, dp)
         }
-        Primitive::Sphere(centre, radius) => {
+        &Primitive::Sphere(centre, radius) => {
             let raw = origin + dir * hit.t;
             let n = (raw - centre).normalize();
             // Re-project onto the surface to shrink the error.
