@@ -327,7 +327,13 @@ impl TileFilm {
         g: &Factor,
         table: &FilterTable,
     ) {
-        let w: [f32; N] = std::array::from_fn(|i| wx[i]);
+        // One load per weight: `separable_row` has just stored them one
+        // at a time, and a 16-byte load of four of them cannot take them
+        // from those stores (it waits until they reach the cache, about 15
+        // cycles per splat). The reads are volatile so that the compiler
+        // does not merge them into that load.
+        // SAFETY: reads of initialised elements of `wx`.
+        let w: [f32; N] = std::array::from_fn(|i| unsafe { std::ptr::read_volatile(&wx[i]) });
         let width = self.bounds.width as usize;
         let mut start = rows.start;
         for y in rows.py0..=rows.py1 {
