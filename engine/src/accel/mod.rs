@@ -386,10 +386,17 @@ impl Accel {
             return (self.blases[0].primitive(hit.prim as usize, tau), None);
         }
         let inst = &self.instances[hit.inst as usize];
-        let blas = inst.blas as usize;
-        let local = (hit.prim - self.bases[blas]) as usize;
+        let (blas, local) = self.located(inst, hit.prim);
         let prim = self.blases[blas].primitive(local, tau);
         (prim, inst.place.at(tau))
+    }
+
+    /// The bottom level of instance `inst` and the index there (leaf
+    /// order) of its primitive numbered `prim` across bottom levels.
+    #[inline(always)]
+    fn located(&self, inst: &Instance, prim: u32) -> (usize, usize) {
+        let blas = inst.blas as usize;
+        (blas, (prim - self.bases[blas]) as usize)
     }
 
     /// Starts loading the record of `hit`'s instance (its placement) into
@@ -410,18 +417,18 @@ impl Accel {
     #[inline(always)]
     pub fn prefetch_primitive(&self, hit: &Hit) {
         let (blas, local) = if self.direct {
-            (0, hit.prim)
+            (0, hit.prim as usize)
         } else {
+            // A miss names no instance.
             let Some(inst) = self.instances.get(hit.inst as usize) else {
                 return;
             };
-            let blas = inst.blas as usize;
-            (blas, hit.prim.wrapping_sub(self.bases[blas]))
+            self.located(inst, hit.prim)
         };
         if let Some(prim) = self
             .blases
             .get(blas)
-            .and_then(|b| b.primitives().get(local as usize))
+            .and_then(|b| b.primitives().get(local))
         {
             prefetch::prefetch(prim);
         }
