@@ -92,8 +92,12 @@ impl Hierarchy {
             return Self::default();
         }
         let mut core_time = Duration::default();
-        let bvh2 =
+        let mut bvh2 =
             obvhs::bvh2::builder::build_bvh2(&usable(boxes), params(quality), &mut core_time);
+        // Parents before children (reinsertion leaves them in any order), so
+        // that a refit is one backward sweep rather than a walk of the tree
+        // first; the wide tree's sources name the nodes in this order.
+        bvh2.reorder_in_stack_traversal_order();
         let wide = WideBvh::build(&bvh2, cost, leaf);
         let built_cost = wide.sah_cost(cost);
         Self {
