@@ -16,13 +16,13 @@
 
 use crate::load::{LoadError, Texels, load};
 use crate::wrap::WrapMode;
+use foldhash::HashMap;
 use radiant_core::glam::Vec2;
 use radiant_core::{
     BuildContext, GpuModule, GpuParams, ModuleInfo, ParamDoc, ParamError, Params, Registry, Rgb,
     Texture,
 };
 use serde::Deserialize;
-use std::collections::HashMap;
 use std::sync::OnceLock;
 
 /// How lookups between texel centres are reconstructed.
@@ -161,7 +161,7 @@ fn texel_coordinate(c: f32) -> f32 {
 /// if there are at most [`PALETTE`].
 fn palette(data: &[Rgb]) -> Option<(Vec<f32>, HashMap<u32, u8>)> {
     let mut values = Vec::new();
-    let mut index = HashMap::new();
+    let mut index = HashMap::default();
     for c in data.iter().flat_map(|c| c.to_array()) {
         if let std::collections::hash_map::Entry::Vacant(e) = index.entry(c.to_bits()) {
             if values.len() == PALETTE {
