@@ -130,6 +130,13 @@ pub fn load_image(path: &Path, raw: bool) -> Result<Texels, LoadError> {
     decode(path, raw, reader)
 }
 
+/// The linear value of each 8-bit sRGB channel value: what
+/// [`srgb_to_linear`] gives for the value as `image` converts it to a
+/// float (`v / 255`).
+fn srgb_8_bit() -> [f32; 256] {
+    std::array::from_fn(|v| srgb_to_linear(v as f32 / 255.0))
+}
+
 /// Decodes the image that `reader` opens (twice: once for its size, which
 /// is checked against the memory left, then for its pixels); `path` names
 /// it in errors.
@@ -150,6 +157,32 @@ fn decode<R: std::io::BufRead + std::io::Seek>(
         decoded.color(),
         image::ColorType::Rgb32F | image::ColorType::Rgba32F
     );
+    let eight_bit = matches!(
+        decoded.color(),
+        image::ColorType::L8
+            | image::ColorType::La8
+            | image::ColorType::Rgb8
+            | image::ColorType::Rgba8
+    );
+    if eight_bit && !raw {
+        // 256 values a channel: decoded once each, not once per texel.
+        let table = srgb_8_bit();
+        let rgb = decoded.to_rgb8();
+        return Ok(Texels {
+            width: rgb.width(),
+            height: rgb.height(),
+            data: rgb
+                .pixels()
+                .map(|p| {
+                    Rgb::new(
+                        table[p[0] as usize],
+                        table[p[1] as usize],
+                        table[p[2] as usize],
+                    )
+                })
+                .collect(),
+        });
+    }
     let rgb = decoded.to_rgb32f();
     let to_linear = |c: f32| {
         if is_float || raw {
@@ -166,4 +199,27 @@ fn decode<R: std::io::BufRead + std::io::Seek>(
             .map(|p| Rgb::new(to_linear(p[0]), to_linear(p[1]), to_linear(p[2])))
             .collect(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_8_bit_table_decodes_as_the_float_path_does() {
+        // Every value as `image` turns it into a float, then decoded: the
+        // table must give the same bits (an 8-bit texture then reads the
+        // same texels as before the table).
+        let bytes: Vec<u8> = (0..=255u8).flat_map(|v| [v, v, v]).collect();
+        let image = image::RgbImage::from_raw(256, 1, bytes).expect("256 pixels");
+        let floats = image::DynamicImage::ImageRgb8(image).to_rgb32f();
+        let table = srgb_8_bit();
+        for (v, p) in floats.pixels().enumerate() {
+            assert_eq!(
+                table[v].to_bits(),
+                srgb_to_linear(p[0]).to_bits(),
+                "value {v}"
+            );
+        }
+    }
 }
