@@ -382,26 +382,22 @@ pub fn choose(
 
 /// `--backend auto`: the GPU where a hardware adapter is found and the
 /// scene has GPU code for all its modules, else the CPU, saying which
-/// through `note`. The adapter is looked for first: planning the scene for
-/// the GPU packs its textures' GPU parameters (a pass over every texel),
-/// which a machine without one would pay for nothing.
+/// through `note`.
 #[cfg(feature = "gpu")]
 fn auto(
     options: &GpuOptions,
     scene: &RenderScene,
     note: &mut dyn FnMut(String),
 ) -> Box<dyn Backend> {
+    if let Err(e) = gpu::Plan::check(scene) {
+        note(format!("backend: cpu ({e})"));
+        return Box::new(CpuBackend);
+    }
     match gpu::GpuBackend::new(options) {
-        Ok(g) if !g.is_software() => match gpu::Plan::check(scene) {
-            Ok(()) => {
-                note(format!("backend: gpu, adapter {}", g.adapter()));
-                Box::new(g)
-            }
-            Err(e) => {
-                note(format!("backend: cpu ({e})"));
-                Box::new(CpuBackend)
-            }
-        },
+        Ok(g) if !g.is_software() => {
+            note(format!("backend: gpu, adapter {}", g.adapter()));
+            Box::new(g)
+        }
         Ok(g) => {
             note(format!(
                 "backend: cpu (the only GPU adapter, {}, is a software one; `--backend gpu` uses it anyway)",
