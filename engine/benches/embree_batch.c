@@ -16,6 +16,8 @@ void rtcCommitGeometry(RTCGeometry g);
 unsigned rtcAttachGeometry(RTCScene s, RTCGeometry g);
 void rtcReleaseGeometry(RTCGeometry g);
 void rtcCommitScene(RTCScene s);
+void rtcSetSceneFlags(RTCScene s, int flags);
+void rtcSetSceneBuildQuality(RTCScene s, int quality);
 void rtcReleaseScene(RTCScene s);
 void rtcReleaseDevice(RTCDevice d);
 
@@ -38,11 +40,15 @@ enum { GEOMETRY_TRIANGLE = 0, BUFFER_INDEX = 0, BUFFER_VERTEX = 1,
 
 static RTCDevice device;
 
-/* A committed scene over `n` triangles `v` (n·9 floats), or NULL. */
-RTCScene peer_scene(const float *v, size_t n) {
+/* A committed scene over `n` triangles `v` (n·9 floats), or NULL; `flags`
+ * are RTCSceneFlags (RTC_SCENE_FLAG_ROBUST = 4), `quality` an
+ * RTCBuildQuality (0 low, 1 medium, Embree's default, 2 high). */
+RTCScene peer_scene(const float *v, size_t n, int flags, int quality) {
     if (!device) device = rtcNewDevice("threads=1");
     if (!device) return NULL;
     RTCScene scene = rtcNewScene(device);
+    rtcSetSceneFlags(scene, flags);
+    rtcSetSceneBuildQuality(scene, quality);
     RTCGeometry g = rtcNewGeometry(device, GEOMETRY_TRIANGLE);
     float *vb = rtcSetNewGeometryBuffer(g, BUFFER_VERTEX, 0, FORMAT_FLOAT3, 12, 3 * n);
     unsigned *ib = rtcSetNewGeometryBuffer(g, BUFFER_INDEX, 0, FORMAT_UINT3, 12, n);

@@ -5,7 +5,11 @@ Builds Embree (through ``embreex``, Embree 4 with its default build) over
 triangles and times single-ray closest-hit and occlusion queries on the rays
 ``engine/examples/trace_probe.rs`` uses, then runs the probe and prints
 nanoseconds per ray of both and Radiant's time as a ratio of Embree's. Both
-run single-threaded on the same machine, best of 5 passes.
+run single-threaded on the same machine, best of 5 passes. ``--robust`` turns
+on Embree's robust mode, whose guarantee Radiant's queries always give
+(watertight triangles, box tests that cover their rounding), and
+``--quality high`` its high-quality build, which Mitsuba 3 uses; neither
+applies to ``--binding``'s figures.
 
 * The Cornell box, always (the scene of the Mitsuba speed benchmark): the
   probe writes its 36 triangles (``--cornell-obj``); 1M rays start at
@@ -136,21 +140,26 @@ def load_batch(tmp):
                     f"-Wl,-rpath,{libs}"], check=True)
     peer = ctypes.CDLL(out)
     peer.peer_scene.restype = ctypes.c_void_p
-    peer.peer_scene.argtypes = [ctypes.c_void_p, ctypes.c_size_t]
+    peer.peer_scene.argtypes = [ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int, ctypes.c_int]
     peer.peer_release.argtypes = [ctypes.c_void_p]
     peer.peer_intersect.argtypes = [ctypes.c_void_p] * 3 + [ctypes.c_size_t] + [ctypes.c_void_p] * 2
     peer.peer_occluded.argtypes = [ctypes.c_void_p] * 4 + [ctypes.c_size_t, ctypes.c_void_p]
     return peer
 
 
+# Embree's scene settings, from the command line (see `main`): scene flags
+# and build quality.
+SCENE = {"flags": 0, "quality": 1}
+
+
 def time_embree_batch(peer, triangles, rays):
     """(closest ns/ray, occluded ns/ray, build ms) of Embree called on whole
-    batches from C ([`load_batch`])."""
+    batches from C ([`load_batch`]), with the `SCENE` settings."""
     import numpy as np
 
     tris = np.ascontiguousarray(triangles, dtype=np.float32)
     start = time.perf_counter()
-    scene = peer.peer_scene(tris.ctypes.data, len(tris))
+    scene = peer.peer_scene(tris.ctypes.data, len(tris), SCENE["flags"], SCENE["quality"])
     build_ms = (time.perf_counter() - start) * 1e3
     origins, dirs, dists = (np.ascontiguousarray(a, dtype=np.float32) for a in rays)
     n = len(origins)
@@ -211,8 +220,15 @@ def main():
     ap.add_argument("--probe", default="target/release/examples/trace_probe")
     ap.add_argument("--binding", action="store_true",
                     help="also time Embree through embreex's per-ray loop")
+    ap.add_argument("--robust", action="store_true",
+                    help="Embree's robust mode (RTC_SCENE_FLAG_ROBUST): no optimisation that "
+                         "loses accuracy, watertight as Radiant's queries always are")
+    ap.add_argument("--quality", choices=["medium", "high"], default="medium",
+                    help="Embree's build quality (medium: its default; high: Mitsuba 3's)")
     ap.add_argument("meshes", nargs="*")
     args = ap.parse_args()
+    SCENE["flags"] = 4 if args.robust else 0
+    SCENE["quality"] = {"medium": 1, "high": 2}[args.quality]
     try:
         import numpy  # noqa: F401
         import embreex  # noqa: F401
