@@ -187,3 +187,46 @@ impl Hierarchy {
         self.cost.map_or(0.0, |c| self.wide.sah_cost(c))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::tests::lcg;
+
+    /// Random boxes of up to a tenth of the unit cube (some `None`).
+    fn boxes(seed: u64, n: usize) -> Vec<Option<Aabb>> {
+        let mut s = seed;
+        (0..n)
+            .map(|i| {
+                let p = Vec3A::new(lcg(&mut s), lcg(&mut s), lcg(&mut s));
+                let e = Vec3A::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 0.1;
+                (i % 97 != 5).then(|| Aabb::new(p, p + e))
+            })
+            .collect()
+    }
+
+    /// Whether every inner node's children come after it, the order in
+    /// which obvhs refits in one backward sweep.
+    fn parents_first(bvh2: &Bvh2) -> bool {
+        bvh2.children_are_ordered_after_parents
+            && bvh2
+                .nodes
+                .iter()
+                .enumerate()
+                .all(|(i, n)| n.is_leaf() || n.first_index as usize > i)
+    }
+
+    #[test]
+    fn builds_and_rebuilds_order_parents_before_children() {
+        for quality in [BuildQuality::Fast, BuildQuality::Medium, BuildQuality::High] {
+            let mut h = Hierarchy::build(&boxes(1, 3000), quality, LeafCost::PACKETS, |l| {
+                0..l.len() as u32
+            });
+            assert!(parents_first(&h.bvh2), "{quality:?}: built");
+            let always = UpdatePolicy { rebuild_above: 0.0 };
+            let update = h.update(&boxes(2, 3000), always, |l| 0..l.len() as u32);
+            assert!(update.rebuilt);
+            assert!(parents_first(&h.bvh2), "{quality:?}: rebuilt");
+        }
+    }
+}
