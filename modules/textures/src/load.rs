@@ -167,38 +167,30 @@ fn decode<R: std::io::BufRead + std::io::Seek>(
     if eight_bit && !raw {
         // 256 values a channel: decoded once each, not once per texel.
         let table = srgb_8_bit();
-        let rgb = decoded.to_rgb8();
-        return Ok(Texels {
-            width: rgb.width(),
-            height: rgb.height(),
-            data: rgb
-                .pixels()
-                .map(|p| {
-                    Rgb::new(
-                        table[p[0] as usize],
-                        table[p[1] as usize],
-                        table[p[2] as usize],
-                    )
-                })
-                .collect(),
-        });
+        return Ok(texels(&decoded.to_rgb8(), |v| table[v as usize]));
     }
-    let rgb = decoded.to_rgb32f();
-    let to_linear = |c: f32| {
-        if is_float || raw {
-            c
-        } else {
-            srgb_to_linear(c)
-        }
-    };
-    Ok(Texels {
+    let linear = is_float || raw;
+    Ok(texels(&decoded.to_rgb32f(), |c| {
+        if linear { c } else { srgb_to_linear(c) }
+    }))
+}
+
+/// The texels of `rgb`, each channel through `channel`.
+fn texels<P: image::Primitive>(
+    rgb: &image::ImageBuffer<image::Rgb<P>, Vec<P>>,
+    channel: impl Fn(P) -> f32,
+) -> Texels
+where
+    image::Rgb<P>: image::Pixel<Subpixel = P>,
+{
+    Texels {
         width: rgb.width(),
         height: rgb.height(),
         data: rgb
             .pixels()
-            .map(|p| Rgb::new(to_linear(p[0]), to_linear(p[1]), to_linear(p[2])))
+            .map(|p| Rgb::new(channel(p[0]), channel(p[1]), channel(p[2])))
             .collect(),
-    })
+    }
 }
 
 #[cfg(test)]
