@@ -45,12 +45,16 @@ pub struct Update {
     pub time: Duration,
 }
 
-/// obvhs' parameters for the binary BVH of `quality`.
-fn params(quality: BuildQuality) -> BvhBuildParams {
+/// obvhs' parameters for the binary BVH of `quality` whose leaves cost
+/// `cost`.
+fn params(quality: BuildQuality, cost: LeafCost) -> BvhBuildParams {
     let mut params = match quality {
         BuildQuality::Fast => BvhBuildParams::fast_build(),
         BuildQuality::Medium => BvhBuildParams::medium_build(),
-        BuildQuality::High => BvhBuildParams::slow_build(),
+        BuildQuality::High => BvhBuildParams {
+            reinsertion_batch_ratio: cost.reinsertion,
+            ..BvhBuildParams::slow_build()
+        },
     };
     // One primitive per leaf: the wide BVH's collapse picks the leaves.
     params.max_prims_per_leaf = 1;
@@ -93,7 +97,7 @@ impl Hierarchy {
         }
         let mut core_time = Duration::default();
         let mut bvh2 =
-            obvhs::bvh2::builder::build_bvh2(&usable(boxes), params(quality), &mut core_time);
+            obvhs::bvh2::builder::build_bvh2(&usable(boxes), params(quality, cost), &mut core_time);
         // Parents before children (reinsertion leaves them in any order), so
         // that a refit is one backward sweep rather than a walk of the tree
         // first; the wide tree's sources name the nodes in this order.

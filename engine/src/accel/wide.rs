@@ -579,6 +579,11 @@ pub struct LeafCost {
     pub cost: fn(u32) -> f32,
     /// Primitives per leaf at most.
     pub max_prims: u32,
+    /// The share of the binary tree's nodes that a
+    /// [`BuildQuality::High`](crate::settings::BuildQuality::High) build
+    /// takes out and re-inserts where they cost least (obvhs'
+    /// `reinsertion_batch_ratio`; 1 re-inserts each node once).
+    pub reinsertion: f32,
 }
 
 impl LeafCost {
@@ -586,13 +591,19 @@ impl LeafCost {
     pub const PACKETS: LeafCost = LeafCost {
         cost: |count| count.div_ceil(4) as f32,
         max_prims: 8,
+        // obvhs' `slow_build`.
+        reinsertion: 0.2,
     };
 
     /// Instances: each is a whole traversal of its own hierarchy, worth
-    /// several nodes; one per leaf.
+    /// several nodes; one per leaf. Every box the build saves a ray is
+    /// worth that much, and a top level has few boxes, so its build
+    /// re-inserts all of its nodes (a field of 10,000 bunnies: 5 % fewer
+    /// instructions per ray; `engine/benches/ANIMATION.md`, "Stop 24").
     pub const INSTANCES: LeafCost = LeafCost {
         cost: |count| 4.0 * count as f32,
         max_prims: 1,
+        reinsertion: 1.0,
     };
 }
 
