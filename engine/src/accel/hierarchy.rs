@@ -221,6 +221,24 @@ mod tests {
     }
 
     #[test]
+    fn a_high_quality_build_reinserts_as_its_leaf_cost_asks() {
+        // The top level's ratio against none: re-insertion must show in
+        // the tree's cost, or `LeafCost::reinsertion` does not reach obvhs.
+        let sah = |reinsertion| {
+            let cost = LeafCost {
+                reinsertion,
+                ..LeafCost::INSTANCES
+            };
+            Hierarchy::build(&boxes(3, 3000), BuildQuality::High, cost, |l| {
+                0..l.len() as u32
+            })
+            .sah_cost()
+        };
+        let (none, thorough) = (sah(0.0), sah(LeafCost::INSTANCES.reinsertion));
+        assert!(thorough < 0.99 * none, "{thorough} against {none}");
+    }
+
+    #[test]
     fn builds_and_rebuilds_order_parents_before_children() {
         for quality in [BuildQuality::Fast, BuildQuality::Medium, BuildQuality::High] {
             let mut h = Hierarchy::build(&boxes(1, 3000), quality, LeafCost::PACKETS, |l| {
