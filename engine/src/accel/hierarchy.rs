@@ -51,10 +51,13 @@ fn params(quality: BuildQuality, cost: LeafCost) -> BvhBuildParams {
     let mut params = match quality {
         BuildQuality::Fast => BvhBuildParams::fast_build(),
         BuildQuality::Medium => BvhBuildParams::medium_build(),
-        BuildQuality::High => BvhBuildParams {
-            reinsertion_batch_ratio: cost.reinsertion,
-            ..BvhBuildParams::slow_build()
-        },
+        BuildQuality::High => {
+            let slow = BvhBuildParams::slow_build();
+            BvhBuildParams {
+                reinsertion_batch_ratio: cost.reinsertion.unwrap_or(slow.reinsertion_batch_ratio),
+                ..slow
+            }
+        }
     };
     // One primitive per leaf: the wide BVH's collapse picks the leaves.
     params.max_prims_per_leaf = 1;
@@ -226,7 +229,7 @@ mod tests {
         // the tree's cost, or `LeafCost::reinsertion` does not reach obvhs.
         let sah = |reinsertion| {
             let cost = LeafCost {
-                reinsertion,
+                reinsertion: Some(reinsertion),
                 ..LeafCost::INSTANCES
             };
             Hierarchy::build(&boxes(3, 3000), BuildQuality::High, cost, |l| {
@@ -234,7 +237,10 @@ mod tests {
             })
             .sah_cost()
         };
-        let (none, thorough) = (sah(0.0), sah(LeafCost::INSTANCES.reinsertion));
+        let (none, thorough) = (
+            sah(0.0),
+            sah(LeafCost::INSTANCES.reinsertion.unwrap_or(0.0)),
+        );
         assert!(thorough < 0.99 * none, "{thorough} against {none}");
     }
 

@@ -582,8 +582,9 @@ pub struct LeafCost {
     /// The share of the binary tree's nodes that a
     /// [`BuildQuality::High`](crate::settings::BuildQuality::High) build
     /// takes out and re-inserts where they cost least (obvhs'
-    /// `reinsertion_batch_ratio`; 1 re-inserts each node once).
-    pub reinsertion: f32,
+    /// `reinsertion_batch_ratio`; 1 re-inserts each node once); `None`
+    /// keeps the share of obvhs' own high-quality build.
+    pub reinsertion: Option<f32>,
 }
 
 impl LeafCost {
@@ -591,8 +592,7 @@ impl LeafCost {
     pub const PACKETS: LeafCost = LeafCost {
         cost: |count| count.div_ceil(4) as f32,
         max_prims: 8,
-        // obvhs' `slow_build`.
-        reinsertion: 0.2,
+        reinsertion: None,
     };
 
     /// Instances: each is a whole traversal of its own hierarchy, worth
@@ -603,7 +603,7 @@ impl LeafCost {
     pub const INSTANCES: LeafCost = LeafCost {
         cost: |count| 4.0 * count as f32,
         max_prims: 1,
-        reinsertion: 1.0,
+        reinsertion: Some(1.0),
     };
 }
 
