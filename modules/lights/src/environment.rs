@@ -254,31 +254,56 @@ impl EnvironmentLight {
     /// density with which `sample` picks it.
     #[inline]
     fn eval_local(&self, d: Vec3) -> EmitterEval {
-        match &self.emission {
-            Emission::Constant(c) => EmitterEval {
-                radiance: *c,
-                pdf: UNIFORM_SPHERE_PDF,
-            },
-            Emission::Map(m) => {
-                let mut u = d.x.atan2(-d.z) / TAU;
-                u -= u.floor();
-                // Near the poles θ comes from sin θ: acos(y) is imprecise
-                // there (y rounds to ±1 within 3e-4 of them).
-                let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
-                let theta = if d.y.abs() < 0.7 {
-                    d.y.acos()
-                } else if d.y > 0.0 {
-                    sin_theta.asin()
-                } else {
-                    PI - sin_theta.asin()
+        let mut eval = EmitterEval::default();
+        self.eval_chunk(&[d], |_, e| eval = e);
+        eval
+    }
+
+    /// [`EnvironmentLight::eval_local`] for each of the light-space
+    /// directions `dirs` (at most [`CHUNK`]), each handed to `each` with
+    /// its index; in stages, as [`Map::sample_chunk`].
+    #[inline]
+    fn eval_chunk(&self, dirs: &[Vec3], mut each: impl FnMut(usize, EmitterEval)) {
+        let m = match &self.emission {
+            Emission::Constant(c) => {
+                let eval = EmitterEval {
+                    radiance: *c,
+                    pdf: UNIFORM_SPHERE_PDF,
                 };
-                let v = theta / PI;
-                let at = m.locate(u, v);
-                EmitterEval {
-                    radiance: m.radiance(&at),
-                    pdf: m.pdf(&at, sin_theta),
-                }
+                (0..dirs.len()).for_each(|i| each(i, eval));
+                return;
             }
+            Emission::Map(m) => m,
+        };
+        let mut places = [(0.0, 0.0, 0.0); CHUNK];
+        for (d, place) in dirs.iter().zip(&mut places) {
+            let mut u = d.x.atan2(-d.z) / TAU;
+            u -= u.floor();
+            // Near the poles θ comes from sin θ: acos(y) is imprecise
+            // there (y rounds to ±1 within 3e-4 of them).
+            let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
+            let theta = if d.y.abs() < 0.7 {
+                d.y.acos()
+            } else if d.y > 0.0 {
+                sin_theta.asin()
+            } else {
+                PI - sin_theta.asin()
+            };
+            *place = (u, theta / PI, sin_theta);
+        }
+        let mut patches = [Patch::default(); CHUNK];
+        for (&(u, v, _), at) in places.iter().zip(&mut patches).take(dirs.len()) {
+            *at = m.locate(u, v);
+        }
+        for (i, (at, (_, _, sin_theta))) in patches.iter().zip(places).take(dirs.len()).enumerate()
+        {
+            each(
+                i,
+                EmitterEval {
+                    radiance: m.radiance(at),
+                    pdf: m.pdf(at, sin_theta),
+                },
+            );
         }
     }
 }
@@ -333,12 +358,17 @@ fn cell_weights(weights: &[f32], size: UVec2) -> Vec<f32> {
 /// Where a (u, v) lies in the map: its cell (between the centres of
 /// pixels x0 and x1 = x0 + 1 (wrapping), rows y0 and y0 + 1) and its
 /// place `t` in [0, 1]² within the cell.
+#[derive(Clone, Copy, Default)]
 struct Patch {
     x0: usize,
     x1: usize,
     y0: usize,
     t: Vec2,
 }
+
+/// Samples or directions that [`Map::sample_chunk`] and
+/// [`EnvironmentLight::eval_chunk`] take through their stages together.
+const CHUNK: usize = 32;
 
 /// The column after `x` (< `w`) in a map `w` wide, wrapping in u.
 #[inline(always)]
@@ -442,27 +472,54 @@ impl Map {
     /// density.
     #[inline]
     fn sample(&self, u: Vec2) -> (Vec3, Rgb, f32) {
+        let mut sample = None;
+        self.sample_chunk(&[u], |_, s| sample = Some(s));
+        sample.expect("one sample for one u")
+    }
+
+    /// [`Map::sample`] for each of `u` (at most [`CHUNK`] of them), each
+    /// result handed to `each` with its index.
+    ///
+    /// The work goes in stages, each a loop over the chunk: the cells'
+    /// rows, their columns, the places within the cells, the directions,
+    /// then radiance and density. Each stage of one sample is a chain of
+    /// dependent steps (loads in the searches, square roots and divisions
+    /// after them); loops this short let the CPU run the chains of many
+    /// samples at once, where one sample at a time would wait for each.
+    #[inline]
+    fn sample_chunk(&self, u: &[Vec2], mut each: impl FnMut(usize, (Vec3, Rgb, f32))) {
         let d = &self.distribution;
-        let (y, ry) = d.marginal().sample(u.y);
-        let (x, rx) = d.rows()[y].sample(u.x);
-        let w = self.size.x as usize;
-        let mut at = Patch {
-            x0: x,
-            x1: next_column(x, w),
-            y0: y,
-            t: Vec2::ZERO,
-        };
-        at.t = sample_bilinear(Vec2::new(rx, ry), self.corners(&self.weights, &at));
-        // Cells start at the first pixel centre, half a pixel into the map.
-        let mut u = (x as f32 + 0.5 + at.t.x) / w as f32;
-        if u >= 1.0 {
-            u -= 1.0;
+        let (w, h) = (self.size.x as usize, self.size.y as usize);
+        let mut patches = [Patch::default(); CHUNK];
+        let patches = &mut patches[..u.len()];
+        // Per sample, its place within the cell's row and column as the
+        // distribution drew it, before the patch's bilinear warp.
+        let mut rest = [Vec2::ZERO; CHUNK];
+        for ((p, r), u) in patches.iter_mut().zip(&mut rest).zip(u) {
+            (p.y0, r.y) = d.marginal().sample(u.y);
         }
-        let v = (y as f32 + at.t.y) / (self.size.y - 1) as f32;
-        let (sin_t, cos_t) = (PI * v).sin_cos();
-        let (sin_p, cos_p) = (TAU * u).sin_cos();
-        let dir = Vec3::new(sin_p * sin_t, cos_t, -cos_p * sin_t);
-        (dir, self.radiance(&at), self.pdf(&at, sin_t))
+        for ((p, r), u) in patches.iter_mut().zip(&mut rest).zip(u) {
+            (p.x0, r.x) = d.rows()[p.y0].sample(u.x);
+            p.x1 = next_column(p.x0, w);
+        }
+        for (p, r) in patches.iter_mut().zip(rest) {
+            p.t = sample_bilinear(r, self.corners(&self.weights, p));
+        }
+        let mut dirs = [(Vec3::ZERO, 0.0); CHUNK];
+        for (p, dir) in patches.iter().zip(&mut dirs) {
+            // Cells start at the first pixel centre, half a pixel into the map.
+            let mut u = (p.x0 as f32 + 0.5 + p.t.x) / w as f32;
+            if u >= 1.0 {
+                u -= 1.0;
+            }
+            let v = (p.y0 as f32 + p.t.y) / (h - 1) as f32;
+            let (sin_t, cos_t) = (PI * v).sin_cos();
+            let (sin_p, cos_p) = (TAU * u).sin_cos();
+            *dir = (Vec3::new(sin_p * sin_t, cos_t, -cos_p * sin_t), sin_t);
+        }
+        for (i, (p, (dir, sin_t))) in patches.iter().zip(dirs).enumerate() {
+            each(i, (dir, self.radiance(p), self.pdf(p, sin_t)));
+        }
     }
 }
 
@@ -495,16 +552,24 @@ impl Light for EnvironmentLight {
                 }
             }
             Emission::Map(m) => {
-                for ((r, u), o) in samples {
-                    *o = to_sample(*r, m.sample(*u));
+                for ((refs, u), out) in refs
+                    .chunks(CHUNK)
+                    .zip(u.chunks(CHUNK))
+                    .zip(out.chunks_mut(CHUNK))
+                {
+                    m.sample_chunk(u, |i, s| out[i] = to_sample(refs[i], s));
                 }
             }
         }
     }
 
     fn eval_escaped(&self, dirs: &[Vec3], out: &mut [EmitterEval]) {
-        for (d, o) in dirs.iter().zip(out.iter_mut()) {
-            *o = self.eval_local(self.to_light * *d);
+        for (dirs, out) in dirs.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
+            let mut local = [Vec3::ZERO; CHUNK];
+            for (l, d) in local.iter_mut().zip(dirs) {
+                *l = self.to_light * *d;
+            }
+            self.eval_chunk(&local[..dirs.len()], |i, e| out[i] = e);
         }
     }
 
