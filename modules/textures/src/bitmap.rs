@@ -116,34 +116,65 @@ impl ImageTexture {
         })
     }
 
+    /// The index in the texels of texel (`x`, `y`), wrapped.
     #[inline]
-    fn texel(&self, x: i64, y: i64) -> Rgb {
+    fn index(&self, x: i64, y: i64) -> usize {
         let (w, h) = (self.texels.width as i64, self.texels.height as i64);
         let i = self.wrap.apply(x, w);
         let j = self.wrap.apply(y, h);
-        self.texels.data[j * w as usize + i]
+        j * w as usize + i
     }
 
+    /// Continuous texel coordinates of `uv`, rows from the top, kept
+    /// finite and far from i64's limits so that the neighbour indices
+    /// cannot overflow.
     #[inline]
-    fn lookup(&self, uv: Vec2) -> Rgb {
-        // Continuous texel coordinates, rows from the top, kept finite and
-        // far from i64's limits so that the neighbour indices cannot overflow.
-        let x = texel_coordinate(uv.x * self.texels.width as f32);
-        let y = texel_coordinate(uv.y * self.texels.height as f32);
-        match self.filtering {
-            Filtering::Nearest => self.texel(x.floor() as i64, y.floor() as i64),
-            Filtering::Bilinear => {
-                let (x, y) = (x - 0.5, y - 0.5);
-                let (x0, y0) = (x.floor(), y.floor());
-                let (fx, fy) = (x - x0, y - y0);
-                let (i, j) = (x0 as i64, y0 as i64);
-                let top = self.texel(i, j).lerp(self.texel(i + 1, j), fx);
-                let bottom = self.texel(i, j + 1).lerp(self.texel(i + 1, j + 1), fx);
-                top.lerp(bottom, fy)
-            }
+    fn coordinates(&self, uv: Vec2) -> (f32, f32) {
+        (
+            texel_coordinate(uv.x * self.texels.width as f32),
+            texel_coordinate(uv.y * self.texels.height as f32),
+        )
+    }
+
+    /// The texels a bilinear lookup at `uv` blends and its weights.
+    #[inline]
+    fn blend_at(&self, uv: Vec2) -> Blend {
+        let (x, y) = self.coordinates(uv);
+        let (x, y) = (x - 0.5, y - 0.5);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (i, j) = (x0 as i64, y0 as i64);
+        Blend {
+            texels: [
+                self.index(i, j),
+                self.index(i + 1, j),
+                self.index(i, j + 1),
+                self.index(i + 1, j + 1),
+            ],
+            f: Vec2::new(x - x0, y - y0),
         }
     }
+
+    /// The bilinear blend `b` of the texels.
+    #[inline]
+    fn blend(&self, b: &Blend) -> Rgb {
+        let t = |k: usize| self.texels.data[b.texels[k]];
+        let top = t(0).lerp(t(1), b.f.x);
+        let bottom = t(2).lerp(t(3), b.f.x);
+        top.lerp(bottom, b.f.y)
+    }
 }
+
+/// A bilinear lookup: the indices of the texels at its four corners
+/// (top left, top right, bottom left, bottom right) and its place `f`
+/// between them.
+#[derive(Clone, Copy, Default)]
+struct Blend {
+    texels: [usize; 4],
+    f: Vec2,
+}
+
+/// Lookups that [`ImageTexture::eval`] takes through its stages together.
+const CHUNK: usize = 32;
 
 /// Clamps a continuous texel coordinate to ±2⁴⁰ (NaN reads as 0): beyond
 /// that an `f32` has no fractional bits left, so no lookup changes.
@@ -175,9 +206,29 @@ fn palette(data: &[Rgb]) -> Option<(Vec<f32>, HashMap<u32, u8>)> {
 }
 
 impl Texture for ImageTexture {
+    /// Bilinear lookups go in two stages per chunk of [`CHUNK`]: first
+    /// where each one reads, then the reads. The texels of a large image
+    /// are mostly not in cache; with the addresses known beforehand, the
+    /// short loop of reads has many of those misses in flight at once.
     fn eval(&self, uv: &[Vec2], out: &mut [Rgb]) {
-        for (o, p) in out.iter_mut().zip(uv) {
-            *o = self.lookup(*p);
+        match self.filtering {
+            Filtering::Nearest => {
+                for (o, p) in out.iter_mut().zip(uv) {
+                    let (x, y) = self.coordinates(*p);
+                    *o = self.texels.data[self.index(x.floor() as i64, y.floor() as i64)];
+                }
+            }
+            Filtering::Bilinear => {
+                for (uv, out) in uv.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
+                    let mut blends = [Blend::default(); CHUNK];
+                    for (b, p) in blends.iter_mut().zip(uv) {
+                        *b = self.blend_at(*p);
+                    }
+                    for (o, b) in out.iter_mut().zip(&blends) {
+                        *o = self.blend(b);
+                    }
+                }
+            }
         }
     }
 

@@ -20,19 +20,45 @@ impl WrapMode {
     #[inline]
     pub fn apply(self, i: i64, n: i64) -> usize {
         (match self {
-            WrapMode::Repeat => i.rem_euclid(n),
+            WrapMode::Repeat => modulo(i, n),
             WrapMode::Clamp => i.clamp(0, n - 1),
             WrapMode::Mirror => {
-                let k = i.rem_euclid(2 * n);
+                let k = modulo(i, 2 * n);
                 if k >= n { 2 * n - 1 - k } else { k }
             }
         }) as usize
     }
 }
 
+/// `i.rem_euclid(n)` (`n` ≥ 1) without a division where `i` lies within
+/// one period of 0..`n`, as nearly every lookup's does (a bilinear
+/// lookup's neighbours step at most one texel outside); a 64-bit division
+/// takes tens of cycles, and a bilinear lookup wraps eight indices.
+#[inline(always)]
+fn modulo(i: i64, n: i64) -> i64 {
+    if (0..n).contains(&i) {
+        i
+    } else if (-n..0).contains(&i) {
+        i + n
+    } else if (n..2 * n).contains(&i) {
+        i - n
+    } else {
+        i.rem_euclid(n)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_modulo_without_division_is_rem_euclid() {
+        for n in [1, 2, 3, 7, 1024] {
+            for i in (-3 * n - 2..3 * n + 2).chain([i64::MIN / 4, i64::MAX / 4]) {
+                assert_eq!(modulo(i, n), i.rem_euclid(n), "{i} mod {n}");
+            }
+        }
+    }
 
     #[test]
     fn indices_map_into_the_image() {
