@@ -58,7 +58,7 @@ impl Distribution1D {
     /// The number of CDF entries ≤ `u`, found between the guide table's
     /// entries around `u`: u ∈ [k/g, (k+1)/g) (exact, g is a power of two)
     /// puts it between entries k and k + 1, as the CDF is non-decreasing.
-    #[inline]
+    #[inline(always)]
     fn search(&self, u: f32) -> usize {
         let g = self.guide.len() - 1;
         // The float-to-int cast saturates: negative and NaN u give 0.
@@ -97,7 +97,7 @@ impl Distribution1D {
 
     /// Samples a cell with `u` in [0, 1); returns the cell and `u`
     /// re-scaled to [0, 1) within it.
-    #[inline]
+    #[inline(always)]
     pub fn sample(&self, u: f32) -> (usize, f32) {
         let n = self.len();
         let i = self.search(u).clamp(1, n) - 1;

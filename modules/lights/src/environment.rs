@@ -30,6 +30,7 @@
 //! ([`Distribution1D::cdf`](radiant_core::distribution::Distribution1D::cdf);
 //! a test holds the two to the same densities and samples).
 
+mod angles;
 mod bilinear;
 
 use crate::map_file::load_map;
@@ -277,18 +278,12 @@ impl EnvironmentLight {
         };
         let mut places = [(0.0, 0.0, 0.0); CHUNK];
         for (d, place) in dirs.iter().zip(&mut places) {
-            let mut u = d.x.atan2(-d.z) / TAU;
+            let mut u = angles::atan2(d.x, -d.z) / TAU;
             u -= u.floor();
-            // Near the poles θ comes from sin θ: acos(y) is imprecise
-            // there (y rounds to ±1 within 3e-4 of them).
+            // θ from both its sine and cosine: accurate at the poles too,
+            // where acos(y) is not (y rounds to ±1 within 3e-4 of them).
             let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
-            let theta = if d.y.abs() < 0.7 {
-                d.y.acos()
-            } else if d.y > 0.0 {
-                sin_theta.asin()
-            } else {
-                PI - sin_theta.asin()
-            };
+            let theta = angles::atan2(sin_theta, d.y);
             *place = (u, theta / PI, sin_theta);
         }
         let mut patches = [Patch::default(); CHUNK];
@@ -513,8 +508,8 @@ impl Map {
                 u -= 1.0;
             }
             let v = (p.y0 as f32 + p.t.y) / (h - 1) as f32;
-            let (sin_t, cos_t) = (PI * v).sin_cos();
-            let (sin_p, cos_p) = (TAU * u).sin_cos();
+            let (sin_t, cos_t) = angles::sin_cos(PI * v);
+            let (sin_p, cos_p) = angles::sin_cos(TAU * u);
             *dir = (Vec3::new(sin_p * sin_t, cos_t, -cos_p * sin_t), sin_t);
         }
         for (i, (p, (dir, sin_t))) in patches.iter().zip(dirs).enumerate() {
