@@ -25,7 +25,7 @@ pub fn square_to_disk_concentric(u: Vec2) -> Vec2 {
 /// terms: the truncation error is below 2e-9, under single-precision
 /// rounding, and the hot sampling path needs no call into libm.
 #[inline]
-fn sin_cos_quarter(phi: f32) -> (f32, f32) {
+pub fn sin_cos_quarter(phi: f32) -> (f32, f32) {
     let x2 = phi * phi;
     let sin = phi
         * (1.0

@@ -1,8 +1,9 @@
 //! The trigonometry between the map's (u, v) and directions: sine and
 //! cosine of an angle in [0, 2π], and the angle of a point of the plane.
 //!
-//! Written out (Cody–Waite reduction and Cephes' minimax polynomials,
-//! within 2 ulp of the exact values) rather than called in the C library:
+//! Written out (a Cody–Waite reduction to radiant_core's
+//! [`sin_cos_quarter`], Cephes' minimax polynomial for atan, within 2 ulp
+//! of the exact values) rather than called in the C library:
 //! every environment sample takes two sines and cosines and every escaped
 //! ray two angles, and a call to libm is a chain of branches and a jump
 //! the CPU cannot overlap with the neighbouring samples' work in the
@@ -10,6 +11,7 @@
 //! adds. Only x86 `f32` arithmetic without fused multiply–adds is used,
 //! so the values do not depend on the instruction set.
 
+use radiant_core::warp::sin_cos_quarter;
 use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
 /// tan(π/8): above it, [`atan_unit`] works on (a − 1)/(a + 1) instead.
@@ -26,10 +28,7 @@ pub(super) fn sin_cos(x: f32) -> (f32, f32) {
     const PI_2_LO: f32 = 7.549_79e-8;
     let q = (x * (1.0 / FRAC_PI_2) + 0.5).floor();
     let r = ((x - q * PI_2_HI) - q * PI_2_MID) - q * PI_2_LO;
-    let z = r * r;
-    let sin_r = ((-1.951_529_6e-4 * z + 8.332_161e-3) * z - 1.666_665_5e-1) * z * r + r;
-    let cos_r =
-        ((2.443_315_7e-5 * z - 1.388_731_6e-3) * z + 4.166_664_6e-2) * z * z - 0.5 * z + 1.0;
+    let (sin_r, cos_r) = sin_cos_quarter(r);
     // sin and cos of q·π/2 + r by the quadrant q mod 4: (sin r, cos r),
     // (cos r, −sin r), (−sin r, −cos r) or (−cos r, sin r). Chosen with
     // bit masks, not branches: random angles would mispredict them.
