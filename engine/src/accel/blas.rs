@@ -10,13 +10,19 @@
 use super::hierarchy::{Hierarchy, Update, UpdatePolicy};
 use super::huge::HugeArray;
 use super::sphere::Sphere4;
+#[cfg(target_arch = "x86_64")]
+use super::triangle::PacketPrep;
 use super::triangle::{RayPrep, Tri4};
 use super::wide::{Isa, LeafCost, LeafVisitor, RayBoxes};
+#[cfg(target_arch = "x86_64")]
+use super::wide::{PACKET, PacketLeafVisitor, RayPacket, lane_mask, lanes_of};
 use super::{Hit, Primitive, ray_is_valid};
 use crate::settings::BuildQuality;
 use glam::{Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use rayon::prelude::*;
+#[cfg(target_arch = "x86_64")]
+use std::arch::x86_64::*;
 use std::borrow::Cow;
 use std::ops::Range;
 
@@ -325,6 +331,72 @@ impl Blas {
         Query::new(&self.packets, closing, ray)
     }
 
+    /// The closest hits of eight rays `origins[i] + t·dirs[i]` (t > 0, at
+    /// shutter time 0) in one traversal of the hierarchy ([`RayPacket`]),
+    /// their primitives numbered from `base`: for rays that visit the same
+    /// nodes, such as the camera rays of one pixel. `None` where they
+    /// cannot share a traversal (their directions' signs or dominant axes
+    /// differ, a ray is not finite, or this level moves under the
+    /// shutter): then trace them one by one.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    pub(super) fn closest_packet(
+        &self,
+        origins: &[Vec3; PACKET],
+        dirs: &[Vec3; PACKET],
+        base: u32,
+    ) -> Option<[Hit; PACKET]> {
+        let valid = (0..PACKET).all(|i| ray_is_valid(origins[i], dirs[i], f32::INFINITY));
+        if self.packets.is_empty() || self.closing.is_some() || !valid {
+            return None;
+        }
+        let (origin, dir) = (lanes_of(origins), lanes_of(dirs));
+        let rays = RayPacket::new(origin, dir)?;
+        let prep = PacketPrep::new(origin, dir)?;
+        Some(if self.spheres {
+            self.closest_packet_in::<true>(&rays, prep, origins, dirs, base)
+        } else {
+            self.closest_packet_in::<false>(&rays, prep, origins, dirs, base)
+        })
+    }
+
+    /// [`Blas::closest_packet`] compiled with or without the sphere test.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn closest_packet_in<const SPHERES: bool>(
+        &self,
+        rays: &RayPacket,
+        prep: PacketPrep,
+        origins: &[Vec3; PACKET],
+        dirs: &[Vec3; PACKET],
+        base: u32,
+    ) -> [Hit; PACKET] {
+        let mut query = PacketQuery::<SPHERES> {
+            packets: &self.packets,
+            origins,
+            dirs,
+            prep,
+            base,
+            prim: [Hit::MISS.prim; PACKET],
+            b1: [0.0; PACKET],
+            b2: [0.0; PACKET],
+        };
+        let mut tmax = [f32::INFINITY; PACKET];
+        self.hierarchy
+            .wide
+            .closest_packet(rays, &mut tmax, (1 << PACKET) - 1, &mut query);
+        std::array::from_fn(|lane| match query.prim[lane] {
+            prim if prim == Hit::MISS.prim => Hit::MISS,
+            prim => Hit {
+                t: tmax[lane],
+                prim,
+                inst: 0,
+                b1: query.b1[lane],
+                b2: query.b2[lane],
+            },
+        })
+    }
+
     /// Whether anything blocks `origin + t·dir` for t in (0, `tmax`) at
     /// shutter time `tau`.
     #[inline(always)]
@@ -570,6 +642,125 @@ impl<const MOVING: bool, const SPHERES: bool> LeafVisitor for Query<'_, MOVING, 
             }
         }
         false
+    }
+}
+
+/// A packet of rays against one bottom level's packets of primitives:
+/// triangles one at a time against all the rays ([`Tri4::test_rays`]),
+/// spheres ray by ray.
+#[cfg(target_arch = "x86_64")]
+struct PacketQuery<'a, const SPHERES: bool> {
+    packets: &'a [Packet],
+    origins: &'a [Vec3; PACKET],
+    dirs: &'a [Vec3; PACKET],
+    prep: PacketPrep,
+    /// Number of the first primitive, added to hits.
+    base: u32,
+    /// Per ray, of its closest hit so far (whose distance is the
+    /// traversal's `tmax`): the primitive ([`Hit::MISS`]'s until one is
+    /// hit) and the barycentrics.
+    prim: [u32; PACKET],
+    b1: [f32; PACKET],
+    b2: [f32; PACKET],
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<const SPHERES: bool> PacketQuery<'_, SPHERES> {
+    /// The triangles of `tris` (`count` from primitive `first` on) against
+    /// `lanes`: lowers each lane's `tmax` to its hits and returns the
+    /// lanes that the single-ray test must decide.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn triangles(
+        &mut self,
+        tris: &Tri4,
+        first: u32,
+        count: u32,
+        lanes: u32,
+        tmax: &mut [f32; PACKET],
+    ) -> u32 {
+        let active = lane_mask(lanes);
+        let mut redo = 0;
+        for j in 0..count as usize {
+            // SAFETY: `tmax` holds eight f32.
+            let t = unsafe { _mm256_loadu_ps(tmax.as_ptr()) };
+            let hits = tris.test_rays(j, &self.prep, t, active);
+            redo |= hits.redo;
+            if hits.hit != 0 {
+                // The hit lanes' new closest hits, blended in.
+                let hit = lane_mask(hits.hit);
+                let prim = _mm256_set1_epi32((self.base + first + j as u32) as i32);
+                // SAFETY: the arrays hold eight 32-bit values each.
+                unsafe {
+                    let update = |at: *mut f32, new: __m256| {
+                        _mm256_storeu_ps(at, _mm256_blendv_ps(_mm256_loadu_ps(at), new, hit));
+                    };
+                    update(tmax.as_mut_ptr(), hits.t);
+                    update(self.b1.as_mut_ptr(), hits.b1);
+                    update(self.b2.as_mut_ptr(), hits.b2);
+                    update(self.prim.as_mut_ptr().cast(), _mm256_castsi256_ps(prim));
+                }
+            }
+        }
+        redo
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<const SPHERES: bool> PacketLeafVisitor for PacketQuery<'_, SPHERES> {
+    #[inline(always)]
+    fn closest(&mut self, range: Range<usize>, lanes: u32, tmax: &mut [f32; PACKET]) {
+        let mut redo = 0;
+        for i in range.clone() {
+            match self.packets[i] {
+                Packet::Triangles {
+                    ref tris,
+                    first,
+                    count,
+                } => {
+                    // SAFETY: packet traversals run only on CPUs with AVX2
+                    // (`Blas::closest_packet`).
+                    redo |= unsafe { self.triangles(tris, first, count, lanes, tmax) };
+                }
+                Packet::Spheres {
+                    ref spheres, first, ..
+                } if SPHERES => {
+                    let mut each = lanes;
+                    while each != 0 {
+                        let lane = each.trailing_zeros() as usize;
+                        each &= each - 1;
+                        let (o, d) = (self.origins[lane], self.dirs[lane]);
+                        if let Some((k, t)) = hit_spheres(spheres, o, d, tmax[lane]) {
+                            tmax[lane] = t;
+                            self.prim[lane] = self.base + first + k as u32;
+                            (self.b1[lane], self.b2[lane]) = (0.0, 0.0);
+                        }
+                    }
+                }
+                // A level without spheres has none.
+                Packet::Spheres { .. } => {}
+            }
+        }
+        // The lanes the packet test left undecided: the leaf again, ray
+        // by ray, from the hits found so far.
+        while redo != 0 {
+            let lane = redo.trailing_zeros() as usize;
+            redo &= redo - 1;
+            let ray = Ray {
+                origin: self.origins[lane],
+                dir: self.dirs[lane],
+                tau: 0.0,
+                prep: self.prep.lane(lane),
+                boxes: RayBoxes::new(self.origins[lane], self.dirs[lane]),
+            };
+            let mut query = Query::<false, SPHERES>::new(self.packets, &[], &ray);
+            query.base = self.base;
+            tmax[lane] = query.closest(range.clone(), tmax[lane]);
+            if query.best.prim != Hit::MISS.prim {
+                let best = query.best;
+                (self.prim[lane], self.b1[lane], self.b2[lane]) = (best.prim, best.b1, best.b2);
+            }
+        }
     }
 }
 

@@ -45,6 +45,8 @@ use std::borrow::Cow;
 use std::marker::PhantomData;
 use std::ops::Range;
 use std::time::{Duration, Instant};
+#[cfg(target_arch = "x86_64")]
+use wide::PACKET;
 use wide::{Avx2, Baseline, Isa, LeafCost, LeafVisitor, RayBoxes};
 
 /// A primitive as the intersector sees it.
@@ -497,6 +499,34 @@ impl Accel {
         ) -> ())
     }
 
+    /// [`Self::intersect_slots`] for rays that come in coherent groups:
+    /// each eight consecutive slots start at about the same point and head
+    /// in about the same direction, as the camera rays of one pixel do.
+    /// Where the CPU has AVX2 and the scene is one level without motion
+    /// blur, such a group is traced as one packet (`wide::packet`);
+    /// every ray gets the hit it gets from [`Self::intersect_slots`], up
+    /// to which of two primitives at exactly the same distance is named.
+    ///
+    /// # Panics
+    ///
+    /// As [`Self::intersect_slots`].
+    pub fn intersect_coherent_slots(
+        &self,
+        slots: &[u32],
+        origins: &[Vec3],
+        dirs: &[Vec3],
+        times: Option<&[f32]>,
+        hits: &mut [Hit],
+    ) {
+        dispatch!(self.intersect_coherent_slots_with(
+            slots: &[u32],
+            origins: &[Vec3],
+            dirs: &[Vec3],
+            times: Option<&[f32]>,
+            hits: &mut [Hit]
+        ) -> ())
+    }
+
     /// For a batch of shadow rays `origins[j] + t·dirs[j]`, t in
     /// (0, `tmax`), at shutter time `times[j]` (0 without `times`): whether
     /// anything blocks ray `j`, in `blocked[j]`. The instruction set is
@@ -548,6 +578,52 @@ impl Accel {
                 }
             }
         }
+    }
+
+    /// [`Self::intersect_coherent_slots`] with the instruction set `I`.
+    #[inline(always)]
+    fn intersect_coherent_slots_with<I: Isa>(
+        &self,
+        slots: &[u32],
+        origins: &[Vec3],
+        dirs: &[Vec3],
+        times: Option<&[f32]>,
+        hits: &mut [Hit],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if I::AVX2 && self.direct && times.is_none() {
+            let mut groups = slots.chunks_exact(PACKET);
+            for group in groups.by_ref() {
+                let first = group[0] as usize;
+                let (o, d): (&[Vec3; PACKET], &[Vec3; PACKET]);
+                let copies: ([Vec3; PACKET], [Vec3; PACKET]);
+                if group[PACKET - 1] as usize == first + PACKET - 1 {
+                    // Consecutive slots (camera rays are) are read in place.
+                    let eight = first..first + PACKET;
+                    o = origins[eight.clone()].try_into().expect("eight rays");
+                    d = dirs[eight].try_into().expect("eight rays");
+                } else {
+                    copies = (
+                        std::array::from_fn(|k| origins[group[k] as usize]),
+                        std::array::from_fn(|k| dirs[group[k] as usize]),
+                    );
+                    (o, d) = (&copies.0, &copies.1);
+                }
+                // SAFETY: `Avx2` traversals run only on CPUs with AVX2
+                // (`Isa`).
+                match unsafe { self.blases[0].closest_packet(o, d, 0) } {
+                    Some(packet) => {
+                        for (&slot, hit) in group.iter().zip(packet) {
+                            hits[slot as usize] = hit;
+                        }
+                    }
+                    None => self.intersect_slots_with::<I>(group, origins, dirs, None, hits),
+                }
+            }
+            self.intersect_slots_with::<I>(groups.remainder(), origins, dirs, None, hits);
+            return;
+        }
+        self.intersect_slots_with::<I>(slots, origins, dirs, times, hits);
     }
 
     /// [`Self::occluded_each`] with the instruction set `I`.
@@ -799,6 +875,9 @@ fn ray_is_valid(origin: Vec3, dir: Vec3, tmax: f32) -> bool {
 }
 
 #[cfg(test)]
+mod packet_tests;
+
+#[cfg(test)]
 pub(crate) mod tests {
     use super::*;
     use triangle::RayPrep;
@@ -993,12 +1072,9 @@ pub(crate) mod tests {
         }
     }
 
-    #[test]
-    fn axis_aligned_rays_find_flat_tiles_at_shared_edges() {
-        // A plane of axis-aligned unit squares (flat boxes in every node);
-        // rays straight down (two direction components zero) at every tile
-        // corner and edge midpoint must hit, whatever the BVH looks like.
-        let n = 12;
+    /// A plane of `n`×`n` axis-aligned squares of side ½ at z = 0, two
+    /// triangles each: edges and vertices shared everywhere.
+    pub(super) fn tiles(n: i32) -> Vec<Primitive> {
         let mut prims = Vec::new();
         for i in 0..n {
             for j in 0..n {
@@ -1007,7 +1083,16 @@ pub(crate) mod tests {
                 prims.push(Primitive::Triangle([p(0, 0), p(1, 1), p(0, 1)]));
             }
         }
-        let (accel, _) = Accel::build(&prims, BuildQuality::Medium);
+        prims
+    }
+
+    #[test]
+    fn axis_aligned_rays_find_flat_tiles_at_shared_edges() {
+        // A plane of axis-aligned unit squares (flat boxes in every node);
+        // rays straight down (two direction components zero) at every tile
+        // corner and edge midpoint must hit, whatever the BVH looks like.
+        let n = 12;
+        let (accel, _) = Accel::build(&tiles(n), BuildQuality::Medium);
         for i in 0..=2 * n {
             for j in 0..=2 * n {
                 let o = Vec3::new(i as f32, j as f32, 4.0) * Vec3::new(0.25, 0.25, 1.0);
@@ -1056,7 +1141,7 @@ pub(crate) mod tests {
     }
 
     /// Random triangles and spheres around the origin, in object space.
-    fn object(seed: u64, n: usize) -> Vec<Primitive> {
+    pub(super) fn object(seed: u64, n: usize) -> Vec<Primitive> {
         let mut s = seed;
         (0..n)
             .map(|i| {
@@ -1073,7 +1158,7 @@ pub(crate) mod tests {
     }
 
     /// `prims` moved to render space by `m` (spheres by a similarity).
-    fn placed(prims: &[Primitive], m: glam::DMat4) -> Vec<Primitive> {
+    pub(super) fn placed(prims: &[Primitive], m: glam::DMat4) -> Vec<Primitive> {
         let p = |v: Vec3| m.transform_point3(v.as_dvec3()).as_vec3();
         let scale = m.transform_vector3(glam::DVec3::X).length() as f32;
         prims

@@ -10,6 +10,12 @@
 //! watertightness carries over. The ray's axis permutation only selects
 //! which coordinate arrays are loaded, so it costs nothing.
 
+#[cfg(target_arch = "x86_64")]
+mod packet;
+
+#[cfg(target_arch = "x86_64")]
+pub use packet::{PacketHits, PacketPrep};
+
 use super::wide::Isa;
 use glam::{BVec4A, DVec3, Vec3, Vec3A, Vec4};
 

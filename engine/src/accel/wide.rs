@@ -21,12 +21,18 @@
 //! so a box never misses a ray that touches it, flat boxes (axis-aligned
 //! triangles) included.
 
+#[cfg(target_arch = "x86_64")]
+mod packet;
+
 use super::huge::HugeArray;
 use glam::{Vec3, Vec3A, Vec4};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
 use std::mem::MaybeUninit;
 use std::ops::Range;
+
+#[cfg(target_arch = "x86_64")]
+pub use packet::{PACKET, PacketLeafVisitor, RayPacket, lane_mask, lanes_of};
 
 /// Children per node.
 const WIDTH: usize = 8;

@@ -471,7 +471,7 @@ impl Wavefront {
         let mut depth = 0u32;
         while !self.live.is_empty() {
             let base = camera_dims + depth * bounce_dims;
-            self.trace_closest(scene);
+            self.trace_closest(scene, depth);
             if has_media {
                 self.media.sample_distances(
                     scene,
@@ -560,11 +560,19 @@ impl Wavefront {
         Some(sorted.unwrap_or_else(|| self.sort_by_material(scene)))
     }
 
-    fn trace_closest(&mut self, scene: &RenderScene) {
+    fn trace_closest(&mut self, scene: &RenderScene, depth: u32) {
         let times = scene.motion_blur().then_some(&self.time[..]);
-        scene
-            .accel
-            .intersect_slots(&self.live, &self.origin, &self.dir, times, &mut self.hit);
+        let (live, origin, dir) = (&self.live[..], &self.origin[..], &self.dir[..]);
+        if depth == 0 {
+            // Camera rays: a pixel's samples one after the other.
+            scene
+                .accel
+                .intersect_coherent_slots(live, origin, dir, times, &mut self.hit);
+        } else {
+            scene
+                .accel
+                .intersect_slots(live, origin, dir, times, &mut self.hit);
+        }
         self.rays += self.live.len() as u64;
     }
 
