@@ -331,10 +331,12 @@ impl Blas {
         Query::new(&self.packets, closing, ray)
     }
 
-    /// The closest hits of eight rays `origins[i] + t·dirs[i]` (t > 0, at
-    /// shutter time 0) in one traversal of the hierarchy ([`RayPacket`]),
-    /// their primitives numbered from `base`: for rays that visit the same
-    /// nodes, such as the camera rays of one pixel. `None` where they
+    /// The closest hits of the rays `origins[i] + t·dirs[i]` of `lanes`
+    /// (a bit each), t in (0, `tmax[i]`) at shutter time 0, in one
+    /// traversal of the hierarchy ([`RayPacket`]), their primitives
+    /// numbered from `base`: for rays that visit the same nodes, such as
+    /// the camera rays of one pixel. The other lanes hold rays too (copies
+    /// of one of `lanes`) and get [`Hit::MISS`]. `None` where the eight
     /// cannot share a traversal (their directions' signs or dominant axes
     /// differ, a ray is not finite, or this level moves under the
     /// shutter): then trace them one by one.
@@ -344,6 +346,8 @@ impl Blas {
         &self,
         origins: &[Vec3; PACKET],
         dirs: &[Vec3; PACKET],
+        lanes: u32,
+        tmax: &[f32; PACKET],
         base: u32,
     ) -> Option<[Hit; PACKET]> {
         let valid = (0..PACKET).all(|i| ray_is_valid(origins[i], dirs[i], f32::INFINITY));
@@ -353,10 +357,19 @@ impl Blas {
         let (origin, dir) = (lanes_of(origins), lanes_of(dirs));
         let rays = RayPacket::new(origin, dir)?;
         let prep = PacketPrep::new(origin, dir)?;
+        // Lanes with no room for a hit (`tmax` not positive, or NaN) miss.
+        let mut tmax = *tmax;
+        let mut active = lanes;
+        for (lane, t) in tmax.iter_mut().enumerate() {
+            if t.is_nan() || *t <= 0.0 || lanes & (1 << lane) == 0 {
+                *t = 0.0;
+                active &= !(1 << lane);
+            }
+        }
         Some(if self.spheres {
-            self.closest_packet_in::<true>(&rays, prep, origins, dirs, base)
+            self.closest_packet_in::<true>(&rays, prep, (origins, dirs), active, tmax, base)
         } else {
-            self.closest_packet_in::<false>(&rays, prep, origins, dirs, base)
+            self.closest_packet_in::<false>(&rays, prep, (origins, dirs), active, tmax, base)
         })
     }
 
@@ -367,8 +380,9 @@ impl Blas {
         &self,
         rays: &RayPacket,
         prep: PacketPrep,
-        origins: &[Vec3; PACKET],
-        dirs: &[Vec3; PACKET],
+        (origins, dirs): (&[Vec3; PACKET], &[Vec3; PACKET]),
+        active: u32,
+        mut tmax: [f32; PACKET],
         base: u32,
     ) -> [Hit; PACKET] {
         let mut query = PacketQuery::<SPHERES> {
@@ -381,10 +395,9 @@ impl Blas {
             b1: [0.0; PACKET],
             b2: [0.0; PACKET],
         };
-        let mut tmax = [f32::INFINITY; PACKET];
         self.hierarchy
             .wide
-            .closest_packet(rays, &mut tmax, (1 << PACKET) - 1, &mut query);
+            .closest_packet(rays, &mut tmax, active, &mut query);
         std::array::from_fn(|lane| match query.prim[lane] {
             prim if prim == Hit::MISS.prim => Hit::MISS,
             prim => Hit {

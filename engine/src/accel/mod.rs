@@ -23,6 +23,7 @@
 //! carry those bounds across ([`instance`]).
 
 mod blas;
+mod coherent;
 pub mod hierarchy;
 mod huge;
 pub mod instance;
@@ -45,8 +46,6 @@ use std::borrow::Cow;
 use std::marker::PhantomData;
 use std::ops::Range;
 use std::time::{Duration, Instant};
-#[cfg(target_arch = "x86_64")]
-use wide::PACKET;
 use wide::{Avx2, Baseline, Isa, LeafCost, LeafVisitor, RayBoxes};
 
 /// A primitive as the intersector sees it.
@@ -578,52 +577,6 @@ impl Accel {
                 }
             }
         }
-    }
-
-    /// [`Self::intersect_coherent_slots`] with the instruction set `I`.
-    #[inline(always)]
-    fn intersect_coherent_slots_with<I: Isa>(
-        &self,
-        slots: &[u32],
-        origins: &[Vec3],
-        dirs: &[Vec3],
-        times: Option<&[f32]>,
-        hits: &mut [Hit],
-    ) {
-        #[cfg(target_arch = "x86_64")]
-        if I::AVX2 && self.direct && times.is_none() {
-            let mut groups = slots.chunks_exact(PACKET);
-            for group in groups.by_ref() {
-                let first = group[0] as usize;
-                let (o, d): (&[Vec3; PACKET], &[Vec3; PACKET]);
-                let copies: ([Vec3; PACKET], [Vec3; PACKET]);
-                if group[PACKET - 1] as usize == first + PACKET - 1 {
-                    // Consecutive slots (camera rays are) are read in place.
-                    let eight = first..first + PACKET;
-                    o = origins[eight.clone()].try_into().expect("eight rays");
-                    d = dirs[eight].try_into().expect("eight rays");
-                } else {
-                    copies = (
-                        std::array::from_fn(|k| origins[group[k] as usize]),
-                        std::array::from_fn(|k| dirs[group[k] as usize]),
-                    );
-                    (o, d) = (&copies.0, &copies.1);
-                }
-                // SAFETY: `Avx2` traversals run only on CPUs with AVX2
-                // (`Isa`).
-                match unsafe { self.blases[0].closest_packet(o, d, 0) } {
-                    Some(packet) => {
-                        for (&slot, hit) in group.iter().zip(packet) {
-                            hits[slot as usize] = hit;
-                        }
-                    }
-                    None => self.intersect_slots_with::<I>(group, origins, dirs, None, hits),
-                }
-            }
-            self.intersect_slots_with::<I>(groups.remainder(), origins, dirs, None, hits);
-            return;
-        }
-        self.intersect_slots_with::<I>(slots, origins, dirs, times, hits);
     }
 
     /// [`Self::occluded_each`] with the instruction set `I`.
@@ -1171,7 +1124,7 @@ pub(crate) mod tests {
     }
 
     /// Similarity transforms for instances (spheres stay spheres).
-    fn placements(seed: u64, n: usize) -> Vec<glam::DMat4> {
+    pub(super) fn placements(seed: u64, n: usize) -> Vec<glam::DMat4> {
         let mut s = seed;
         (0..n)
             .map(|_| {
@@ -1187,6 +1140,28 @@ pub(crate) mod tests {
             .collect()
     }
 
+    /// Bottom levels and instances: `statics` in render space (instance 0
+    /// of level 0), `shape` placed by each of `places` (level 1).
+    pub(super) fn two_levels(
+        statics: &[Primitive],
+        shape: &[Primitive],
+        places: &[glam::DMat4],
+    ) -> (Vec<Blas>, Vec<Instance>) {
+        let blases = vec![
+            Blas::build(statics, None, BuildQuality::Medium),
+            Blas::build(shape, None, BuildQuality::Medium),
+        ];
+        let mut instances = vec![Instance {
+            blas: 0,
+            place: Place::Identity,
+        }];
+        instances.extend(places.iter().map(|m| Instance {
+            blas: 1,
+            place: Place::Fixed(Placement::new(*m).expect("invertible")),
+        }));
+        (blases, instances)
+    }
+
     #[test]
     fn two_levels_find_the_hits_of_one() {
         // Two shapes: one static in render space, one instanced five times.
@@ -1198,18 +1173,7 @@ pub(crate) mod tests {
             flat.extend(placed(&shape, *m));
         }
         let (one, order) = Accel::build(&flat, BuildQuality::Medium);
-        let blases = vec![
-            Blas::build(&statics, None, BuildQuality::Medium),
-            Blas::build(&shape, None, BuildQuality::Medium),
-        ];
-        let mut instances = vec![Instance {
-            blas: 0,
-            place: Place::Identity,
-        }];
-        instances.extend(places.iter().map(|m| Instance {
-            blas: 1,
-            place: Place::Fixed(Placement::new(*m).expect("invertible")),
-        }));
+        let (blases, instances) = two_levels(&statics, &shape, &places);
         let two = Accel::new(blases, instances, BuildQuality::Medium);
         assert!(!two.direct);
         // The flat soup's primitive `i` as (instance, primitive of its shape).
@@ -1266,10 +1230,9 @@ pub(crate) mod tests {
         assert!(hits > 2000, "only {hits} rays hit");
     }
 
-    #[test]
-    fn a_moving_instance_is_hit_where_it_is_at_the_ray_time() {
-        let shape = object(4, 150);
-        let motion = Motion {
+    /// A motion over the shutter: moved, turned and grown.
+    pub(super) fn swing() -> Motion {
+        Motion {
             outer: glam::DMat4::from_translation(glam::DVec3::new(0.0, 0.0, -3.0)),
             open: crate::world::Trs::IDENTITY,
             close: crate::world::Trs {
@@ -1278,7 +1241,13 @@ pub(crate) mod tests {
                 scale: glam::DVec3::splat(1.5),
             },
             inner: glam::DMat4::from_translation(glam::DVec3::new(0.5, 0.0, 0.0)),
-        };
+        }
+    }
+
+    #[test]
+    fn a_moving_instance_is_hit_where_it_is_at_the_ray_time() {
+        let shape = object(4, 150);
+        let motion = swing();
         let moving = Accel::new(
             vec![Blas::build(&shape, None, BuildQuality::Medium)],
             vec![Instance {

@@ -2,7 +2,7 @@
 //! ([`Accel::intersect_coherent_slots`]) against the single-ray traversal:
 //! every ray must get the hit it gets alone, bit for bit.
 
-use super::tests::{lcg, object, placed, tiles};
+use super::tests::{lcg, object, placed, placements, swing, tiles, two_levels};
 use super::*;
 
 /// A random unit vector.
@@ -107,7 +107,7 @@ fn packets_taken(accel: &Accel, origins: &[Vec3], dirs: &[Vec3]) -> usize {
         .filter(|(o, d)| {
             let (o, d) = ((*o).try_into().unwrap(), (*d).try_into().unwrap());
             // SAFETY: the CPU has AVX2 (checked above).
-            unsafe { accel.blases[0].closest_packet(o, d, 0) }.is_some()
+            unsafe { accel.closest_packet::<Avx2>(o, d) }.is_some()
         })
         .count()
 }
@@ -279,27 +279,48 @@ fn rays_that_cannot_share_a_traversal_are_traced_one_by_one() {
 }
 
 #[test]
-fn two_level_scenes_and_shutter_times_answer_coherent_queries() {
-    // Packets are traced in one-level scenes without shutter times; the
-    // others fall back to single rays.
-    let shape = soup(21, 100);
-    let blases = vec![Blas::build(&shape, None, BuildQuality::Medium)];
-    let instances = [glam::DVec3::ZERO, glam::DVec3::new(0.5, 0.0, 3.0)]
-        .map(|offset| Instance {
-            blas: 0,
-            place: Place::Fixed(
-                Placement::new(glam::DMat4::from_translation(offset)).expect("invertible"),
-            ),
-        })
-        .to_vec();
+fn coherent_rays_through_a_top_level_get_their_single_ray_hits() {
+    // A shape in render space, another placed eight times (rotated and
+    // scaled: a packet's rays may part ways in an instance's space) and
+    // once moving (at shutter time 0 without times).
+    let statics = soup(41, 300);
+    let shape = object(42, 200);
+    let places = placements(43, 8);
+    let (mut blases, mut instances) = two_levels(&statics, &shape, &places);
+    blases.push(Blas::build(&shape, None, BuildQuality::Medium));
+    instances.push(Instance {
+        blas: 2,
+        place: Place::Moving(Box::new(swing())),
+    });
     let mut two = Accel::new(blases, instances, BuildQuality::Medium);
     assert!(!two.direct);
+    // Aimed at the primitives as placed.
+    let mut targets = statics.clone();
+    for m in &places {
+        targets.extend(placed(&shape, *m));
+    }
     let mut s = 31;
-    let (origins, dirs) = pixel_rays(&mut s, &shape, 20, 1e-3);
+    for spread in [0.0, 1e-3, 0.05] {
+        let (origins, dirs) = pixel_rays(&mut s, &targets, 60, spread);
+        let all: Vec<u32> = (0..origins.len() as u32).collect();
+        assert_coherent_hits_match(&mut two, &all, &origins, &dirs, None);
+        let sparse: Vec<u32> = all.iter().copied().filter(|j| j % 5 != 1).collect();
+        assert_coherent_hits_match(&mut two, &sparse, &origins, &dirs, None);
+        assert_most_groups_are_packets(&two, &origins, &dirs);
+        let mut hits = vec![Hit::MISS; origins.len()];
+        two.intersect_coherent_slots(&all, &origins, &dirs, None, &mut hits);
+        let instanced = hits
+            .iter()
+            .filter(|h| h.prim != Hit::MISS.prim && h.inst > 0)
+            .count();
+        assert!(instanced >= 50, "only {instanced} rays hit an instance");
+    }
+    // With shutter times, one and two levels take the single-ray path.
+    let (origins, dirs) = pixel_rays(&mut s, &targets, 20, 1e-3);
     let all: Vec<u32> = (0..origins.len() as u32).collect();
-    assert_coherent_hits_match(&mut two, &all, &origins, &dirs, None);
-    let (mut one, _) = Accel::build(&shape, BuildQuality::Medium);
     let times: Vec<f32> = (0..origins.len()).map(|_| lcg(&mut s)).collect();
+    assert_coherent_hits_match(&mut two, &all, &origins, &dirs, Some(&times));
+    let (mut one, _) = Accel::build(&statics, BuildQuality::Medium);
     assert_coherent_hits_match(&mut one, &all, &origins, &dirs, Some(&times));
 }
 

@@ -1,0 +1,198 @@
+//! Closest hits of coherent rays, eight at a time.
+//!
+//! [`Accel::intersect_coherent_slots`] takes rays in groups of eight that
+//! start at about the same point and head in about the same direction (a
+//! pixel's camera rays) and, where the CPU has AVX2, traces each group as
+//! one packet (`wide::packet`): through the bottom level of a one-level
+//! scene, or through the top level and then, instance by instance, through
+//! the bottom levels of the lanes that enter each one (their rays moved to
+//! the instance's space lane by lane, exactly as a single ray's are). Each
+//! ray gets the hit it gets alone, up to which of two primitives at
+//! exactly the same distance is named. Groups that cannot share a
+//! traversal, rays at shutter times, and CPUs without AVX2 take the
+//! single-ray path.
+
+use super::wide::Isa;
+use super::{Accel, Hit};
+use glam::Vec3;
+#[cfg(target_arch = "x86_64")]
+use {
+    super::TopEntry,
+    super::ray_is_valid,
+    super::wide::{PACKET, PacketLeafVisitor, RayPacket, lanes_of},
+    std::marker::PhantomData,
+    std::ops::Range,
+};
+
+/// All eight lanes of a packet.
+#[cfg(target_arch = "x86_64")]
+const ALL_LANES: u32 = (1 << PACKET) - 1;
+
+impl Accel {
+    /// [`Self::intersect_coherent_slots`] with the instruction set `I`.
+    #[inline(always)]
+    pub(super) fn intersect_coherent_slots_with<I: Isa>(
+        &self,
+        slots: &[u32],
+        origins: &[Vec3],
+        dirs: &[Vec3],
+        times: Option<&[f32]>,
+        hits: &mut [Hit],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if I::AVX2 && times.is_none() {
+            let mut groups = slots.chunks_exact(PACKET);
+            for group in groups.by_ref() {
+                let first = group[0] as usize;
+                let (o, d): (&[Vec3; PACKET], &[Vec3; PACKET]);
+                let copies: ([Vec3; PACKET], [Vec3; PACKET]);
+                if group[PACKET - 1] as usize == first + PACKET - 1 {
+                    // Consecutive slots (camera rays are) are read in place.
+                    let eight = first..first + PACKET;
+                    o = origins[eight.clone()].try_into().expect("eight rays");
+                    d = dirs[eight].try_into().expect("eight rays");
+                } else {
+                    copies = (
+                        std::array::from_fn(|k| origins[group[k] as usize]),
+                        std::array::from_fn(|k| dirs[group[k] as usize]),
+                    );
+                    (o, d) = (&copies.0, &copies.1);
+                }
+                // SAFETY: `Avx2` traversals run only on CPUs with AVX2
+                // (`Isa`).
+                match unsafe { self.closest_packet::<I>(o, d) } {
+                    Some(packet) => {
+                        for (&slot, hit) in group.iter().zip(packet) {
+                            hits[slot as usize] = hit;
+                        }
+                    }
+                    None => self.intersect_slots_with::<I>(group, origins, dirs, None, hits),
+                }
+            }
+            self.intersect_slots_with::<I>(groups.remainder(), origins, dirs, None, hits);
+            return;
+        }
+        self.intersect_slots_with::<I>(slots, origins, dirs, times, hits);
+    }
+
+    /// The closest hits of eight rays at shutter time 0 in one traversal,
+    /// or `None` where they cannot share one.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    pub(super) fn closest_packet<I: Isa>(
+        &self,
+        origins: &[Vec3; PACKET],
+        dirs: &[Vec3; PACKET],
+    ) -> Option<[Hit; PACKET]> {
+        let tmax = [f32::INFINITY; PACKET];
+        if self.direct {
+            // Instance 0 of bottom level 0, whose primitives start at 0.
+            return self.blases[0].closest_packet(origins, dirs, ALL_LANES, &tmax, 0);
+        }
+        let valid = (0..PACKET).all(|i| ray_is_valid(origins[i], dirs[i], f32::INFINITY));
+        if self.tlas.wide.is_empty() || !valid {
+            return None;
+        }
+        let rays = RayPacket::new(lanes_of(origins), lanes_of(dirs))?;
+        let mut query = TopPacketQuery::<I> {
+            accel: self,
+            origins,
+            dirs,
+            best: [Hit::MISS; PACKET],
+            isa: PhantomData,
+        };
+        let mut tmax = tmax;
+        self.tlas
+            .wide
+            .closest_packet(&rays, &mut tmax, ALL_LANES, &mut query);
+        Some(query.best)
+    }
+}
+
+/// A packet's query of the top level: at each leaf, the lanes that reach
+/// an instance enter its space and traverse its bottom level together
+/// where they still can, one by one where not.
+#[cfg(target_arch = "x86_64")]
+struct TopPacketQuery<'a, I> {
+    accel: &'a Accel,
+    origins: &'a [Vec3; PACKET],
+    dirs: &'a [Vec3; PACKET],
+    /// Each lane's closest hit so far.
+    best: [Hit; PACKET],
+    isa: PhantomData<I>,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<I: Isa> TopPacketQuery<'_, I> {
+    /// The rays of `lanes` against instance `entry`: lowers their `tmax`
+    /// to the hits they find.
+    #[target_feature(enable = "avx2")]
+    fn instance(&mut self, entry: &TopEntry, lanes: u32, tmax: &mut [f32; PACKET]) {
+        // Each lane's ray in the instance's space, as `TopQuery::enter`
+        // moves a single ray there, with its remaining reach.
+        let (mut origins, mut dirs) = (*self.origins, *self.dirs);
+        let (mut shift, mut reach) = ([0.0; PACKET], [0.0; PACKET]);
+        let mut entered = 0u32;
+        let mut each = lanes;
+        while each != 0 {
+            let lane = each.trailing_zeros() as usize;
+            each &= each - 1;
+            let ray = self
+                .accel
+                .top_query::<I>(self.origins[lane], self.dirs[lane], 0.0);
+            if let Some((o, d, dt)) = ray.enter(entry) {
+                (origins[lane], dirs[lane]) = (o, d);
+                (shift[lane], reach[lane]) = (dt, tmax[lane] - dt);
+                entered |= 1 << lane;
+            }
+        }
+        if entered == 0 {
+            return;
+        }
+        // The other lanes ride along as copies of an entered one, so that
+        // they do not keep the packet from forming.
+        let first = entered.trailing_zeros() as usize;
+        for lane in 0..PACKET {
+            if entered & (1 << lane) == 0 {
+                (origins[lane], dirs[lane]) = (origins[first], dirs[first]);
+            }
+        }
+        let blas = &self.accel.blases[entry.blas() as usize];
+        let hits = blas
+            .closest_packet(&origins, &dirs, entered, &reach, entry.base())
+            .unwrap_or_else(|| {
+                std::array::from_fn(|lane| match entered & (1 << lane) {
+                    0 => Hit::MISS,
+                    _ => {
+                        blas.closest::<I>(origins[lane], dirs[lane], reach[lane], 0.0, entry.base())
+                    }
+                })
+            });
+        let mut each = entered;
+        while each != 0 {
+            let lane = each.trailing_zeros() as usize;
+            each &= each - 1;
+            let hit = hits[lane];
+            if hit.prim != Hit::MISS.prim {
+                tmax[lane] = hit.t + shift[lane];
+                self.best[lane] = Hit {
+                    t: tmax[lane],
+                    inst: entry.inst(),
+                    ..hit
+                };
+            }
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<I: Isa> PacketLeafVisitor for TopPacketQuery<'_, I> {
+    #[inline(always)]
+    fn closest(&mut self, range: Range<usize>, lanes: u32, tmax: &mut [f32; PACKET]) {
+        for entry in &self.accel.tlas_entries[range] {
+            // SAFETY: packet traversals run only on CPUs with AVX2
+            // (`Accel::closest_packet`).
+            unsafe { self.instance(entry, lanes, tmax) };
+        }
+    }
+}
