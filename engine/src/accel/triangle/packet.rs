@@ -33,7 +33,7 @@ pub struct PacketPrep {
 impl PacketPrep {
     /// Prepares the rays with origins `origin` and directions `dir`
     /// (structure-of-arrays: per axis, the eight rays' coordinates); `None`
-    /// unless they have the same dominant axis ([`super::axes_index`]'s
+    /// unless they have the same dominant axis (`axes_index`'s
     /// rule, ties included).
     ///
     /// # Safety

@@ -3,20 +3,21 @@
 //! Camera rays through one pixel (a batch holds a pixel's samples one
 //! after the other) start at the same point and leave in nearly the same
 //! direction, so they visit the same nodes. [`WideBvh::closest_packet`]
-//! visits each of those nodes once for eight of them: the rays are the
+//! visits each of those nodes once for the eight of them: the rays are the
 //! eight AVX lanes, tested against one child box after another, instead of
-//! one ray's test against the eight boxes of each node it visits, once per
-//! ray. A node then costs about a third of eight single-ray visits.
+//! each ray testing the eight boxes of every node it visits on its own.
 //!
 //! Each lane's box test is the single-ray test's operations in the same
-//! order, so a lane meets exactly the boxes its ray would alone. Leaves
-//! are intersected lane by lane with each ray's own [`LeafVisitor`], so
-//! every ray gets the hit that [`WideBvh::closest`] finds (up to which of
-//! two primitives at exactly the same distance wins, which depends on the
-//! order the leaves are visited in). The rays must share the signs of their
-//! directions ([`RayPacket::new`]), which makes the near and far side of
-//! each box the same for all lanes; rays of one pixel always do, and eight
-//! incoherent rays almost never.
+//! order, so a lane meets exactly the boxes its ray would alone. A leaf
+//! goes to a [`PacketLeafVisitor`] with the lanes that reach it (a bottom
+//! level tests one triangle against all of them, `Tri4::test_rays`; a top
+//! level enters its instances lane by lane), so every ray gets the hit
+//! that [`WideBvh::closest`] finds (up to which of two primitives at
+//! exactly the same distance wins, which depends on the order the leaves
+//! are visited in). The rays must share the signs of their directions
+//! ([`RayPacket::new`]), which makes the near and far side of each box the
+//! same for all lanes; rays of one pixel do unless they straddle an axis,
+//! and eight incoherent rays almost never.
 
 use super::{AXIS_BYTES, SIDE_BYTES};
 use super::{FAR_SCALE, MAX_DEPTH, Node, OFFSETS, Offsets, WIDTH, WideBvh};
