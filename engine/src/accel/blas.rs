@@ -694,14 +694,19 @@ impl<const SPHERES: bool> PacketQuery<'_, SPHERES> {
     ) -> u32 {
         let active = lane_mask(lanes);
         let mut redo = 0;
+        // All four triangles against one `tmax`, the nearest hit kept (the
+        // first of equally near ones), as `Tri4::closest` does.
+        // SAFETY: `tmax` holds eight f32.
+        let reach = unsafe { _mm256_loadu_ps(tmax.as_ptr()) };
         for j in 0..count as usize {
-            // SAFETY: `tmax` holds eight f32.
-            let t = unsafe { _mm256_loadu_ps(tmax.as_ptr()) };
-            let hits = tris.test_rays(j, &self.prep, t, active);
+            let hits = tris.test_rays(j, &self.prep, reach, active);
             redo |= hits.redo;
-            if hits.hit != 0 {
+            // SAFETY: as above.
+            let nearest = unsafe { _mm256_loadu_ps(tmax.as_ptr()) };
+            let nearer = _mm256_cmp_ps::<_CMP_LT_OQ>(hits.t, nearest);
+            let hit = _mm256_and_ps(lane_mask(hits.hit), nearer);
+            if _mm256_movemask_ps(hit) != 0 {
                 // The hit lanes' new closest hits, blended in.
-                let hit = lane_mask(hits.hit);
                 let prim = _mm256_set1_epi32((self.base + first + j as u32) as i32);
                 // SAFETY: the arrays hold eight 32-bit values each.
                 unsafe {

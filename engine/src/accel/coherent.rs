@@ -46,7 +46,11 @@ impl Accel {
                 let first = group[0] as usize;
                 let (o, d): (&[Vec3; PACKET], &[Vec3; PACKET]);
                 let copies: ([Vec3; PACKET], [Vec3; PACKET]);
-                if group[PACKET - 1] as usize == first + PACKET - 1 {
+                let consecutive = group
+                    .iter()
+                    .enumerate()
+                    .all(|(k, &slot)| slot as usize == first + k);
+                if consecutive {
                     // Consecutive slots (camera rays are) are read in place.
                     let eight = first..first + PACKET;
                     o = origins[eight.clone()].try_into().expect("eight rays");

@@ -146,6 +146,16 @@ fn coherent_rays_get_their_single_ray_hits_on_random_soups() {
             assert_coherent_hits_match(&mut accel, &sparse, &origins, &dirs, None);
             let reversed: Vec<u32> = all.iter().rev().copied().collect();
             assert_coherent_hits_match(&mut accel, &reversed, &origins, &dirs, None);
+            // Groups whose ends are eight apart but whose middles are
+            // permuted or repeated: not to be read in place.
+            let mut shuffled = all.clone();
+            for group in shuffled.chunks_exact_mut(8).step_by(2) {
+                group.swap(1, 2);
+            }
+            for group in shuffled.chunks_exact_mut(8).skip(1).step_by(4) {
+                group[5] = group[4];
+            }
+            assert_coherent_hits_match(&mut accel, &shuffled, &origins, &dirs, None);
             // Most coherent groups share a traversal (those whose
             // directions straddle an axis or a dominant-axis boundary
             // cannot), so the comparison above is the packet path's.
