@@ -370,3 +370,75 @@ fn coherent_rays_leaving_a_tilted_surface_get_their_single_ray_hits() {
     assert_coherent_hits_match(&mut accel, &all, &origins, &dirs, None);
     assert_most_groups_are_packets(&accel, &origins, &dirs);
 }
+
+#[cfg(target_arch = "x86_64")]
+#[test]
+fn a_bottom_level_packet_with_some_lanes_and_reaches_gets_single_ray_hits() {
+    // What an instance's bottom level gets from a top-level packet: only
+    // the lanes that entered it, the others copies, each lane with its
+    // own reach (some used up, one NaN).
+    if !Avx2::detected() {
+        eprintln!("no AVX2: packets are never traced on this CPU");
+        return;
+    }
+    let shape = object(51, 400);
+    let blas = Blas::build(&shape, None, BuildQuality::Medium);
+    let mut s = 52;
+    let (origins, dirs) = pixel_rays(&mut s, &shape, 80, 1e-3);
+    let (mut formed, mut hit) = (0, 0);
+    for (g, (o, d)) in origins
+        .chunks_exact(8)
+        .zip(dirs.chunks_exact(8))
+        .enumerate()
+    {
+        let lanes: u32 = match g % 4 {
+            0 => 0xff,
+            1 => 0b1010_0110,
+            2 => 0b0001_0000,
+            _ => 0b0111_1110,
+        };
+        let reach: [f32; 8] = std::array::from_fn(|k| match (g + k) % 7 {
+            0 => 0.0,
+            1 => -1.0,
+            2 => f32::NAN,
+            3 => 0.5 + 4.0 * lcg(&mut s),
+            _ => f32::INFINITY,
+        });
+        let first = lanes.trailing_zeros() as usize;
+        let o: [Vec3; 8] = std::array::from_fn(|k| {
+            if lanes & (1 << k) != 0 {
+                o[k]
+            } else {
+                o[first]
+            }
+        });
+        let d: [Vec3; 8] = std::array::from_fn(|k| {
+            if lanes & (1 << k) != 0 {
+                d[k]
+            } else {
+                d[first]
+            }
+        });
+        // SAFETY: the CPU has AVX2 (checked above).
+        let Some(hits) = (unsafe { blas.closest_packet(&o, &d, lanes, &reach, 7) }) else {
+            continue;
+        };
+        formed += 1;
+        for k in 0..8 {
+            let alone = match lanes & (1 << k) {
+                0 => Hit::MISS,
+                _ => blas.closest::<Avx2>(o[k], d[k], reach[k], 0.0, 7),
+            };
+            if hits[k] != alone {
+                assert!(
+                    hits[k].t == alone.t && hits[k].prim != alone.prim,
+                    "group {g}, lane {k}: alone {alone:?}, in a packet {:?}",
+                    hits[k]
+                );
+            }
+            hit += usize::from(alone.prim != Hit::MISS.prim);
+        }
+    }
+    assert!(formed >= 40, "only {formed} of 80 groups formed packets");
+    assert!(hit >= 60, "only {hit} lanes hit");
+}
