@@ -88,7 +88,7 @@ impl Accel {
         origins: &[Vec3; PACKET],
         dirs: &[Vec3; PACKET],
     ) -> Option<[Hit; PACKET]> {
-        let tmax = [f32::INFINITY; PACKET];
+        let mut tmax = [f32::INFINITY; PACKET];
         if self.direct {
             // Instance 0 of bottom level 0, whose primitives start at 0.
             return self.blases[0].closest_packet(origins, dirs, ALL_LANES, &tmax, 0);
@@ -105,7 +105,6 @@ impl Accel {
             best: [Hit::MISS; PACKET],
             isa: PhantomData,
         };
-        let mut tmax = tmax;
         self.tlas
             .wide
             .closest_packet(&rays, &mut tmax, ALL_LANES, &mut query);

@@ -501,8 +501,9 @@ impl Accel {
     /// [`Self::intersect_slots`] for rays that come in coherent groups:
     /// each eight consecutive slots start at about the same point and head
     /// in about the same direction, as the camera rays of one pixel do.
-    /// Where the CPU has AVX2 and the scene is one level without motion
-    /// blur, such a group is traced as one packet (`wide::packet`);
+    /// Where the CPU has AVX2 and no shutter times are given, such a
+    /// group is traced as one packet, through both levels
+    /// (`accel/coherent.rs`);
     /// every ray gets the hit it gets from [`Self::intersect_slots`], up
     /// to which of two primitives at exactly the same distance is named.
     ///

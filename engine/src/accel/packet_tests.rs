@@ -105,7 +105,10 @@ fn packets_taken(accel: &Accel, origins: &[Vec3], dirs: &[Vec3]) -> usize {
         .chunks_exact(8)
         .zip(dirs.chunks_exact(8))
         .filter(|(o, d)| {
-            let (o, d) = ((*o).try_into().unwrap(), (*d).try_into().unwrap());
+            let (o, d) = (
+                (*o).try_into().expect("eight"),
+                (*d).try_into().expect("eight"),
+            );
             // SAFETY: the CPU has AVX2 (checked above).
             unsafe { accel.closest_packet::<Avx2>(o, d) }.is_some()
         })

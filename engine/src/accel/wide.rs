@@ -125,6 +125,15 @@ impl Node {
             | signs(&self.child[4..]).is_negative_bitmask() << 4
     }
 
+    /// Bit `lane` is set where the lane holds a child: its box is not
+    /// empty (an unused lane's minimum is +∞ and its maximum −∞).
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn used(&self) -> u32 {
+        let [min, max] = [&self.bounds[0][0], &self.bounds[1][0]];
+        min[0].cmple(max[0]).bitmask() | min[1].cmple(max[1]).bitmask() << 4
+    }
+
     /// The item range of leaf `lane`.
     #[inline(always)]
     fn items(&self, lane: usize) -> Range<usize> {

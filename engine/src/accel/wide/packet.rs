@@ -19,7 +19,6 @@
 //! same for all lanes; rays of one pixel do unless they straddle an axis,
 //! and eight incoherent rays almost never.
 
-use super::{AXIS_BYTES, SIDE_BYTES};
 use super::{FAR_SCALE, MAX_DEPTH, Node, OFFSETS, Offsets, WIDTH, WideBvh};
 use glam::Vec3;
 use std::arch::x86_64::*;
@@ -201,24 +200,6 @@ fn lanes_within(tmax: &[f32; PACKET], t: f32, lanes: u32) -> u32 {
     within(_mm256_set1_ps(t), tmax) & lanes
 }
 
-/// Which lanes of a node hold children: those whose box is not empty (an
-/// unused lane's minimum is +∞ and its maximum −∞).
-#[target_feature(enable = "avx2")]
-#[inline]
-fn used_lanes(node: &Node) -> u32 {
-    let bytes = (node as *const Node).cast::<u8>();
-    // SAFETY: x's minima and maxima are eight contiguous f32 each, at
-    // offsets 0 and `SIDE_BYTES` of the 64-byte aligned node.
-    let (min, max) = unsafe {
-        (
-            _mm256_load_ps(bytes.cast()),
-            _mm256_load_ps(bytes.add(SIDE_BYTES).cast()),
-        )
-    };
-    const _: () = assert!(AXIS_BYTES == 32);
-    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(min, max)) as u32
-}
-
 /// Of the children in `children` (a bit each, at least one), the one
 /// with the smallest `t_min`; the first of equal ones.
 #[inline(always)]
@@ -261,7 +242,7 @@ impl WideBvh {
             let active_mask = lane_mask(active);
             let (mut leaf_hits, mut inner_hits) = (0u32, 0u32);
             let leaf_lanes = node.leaves();
-            let mut used = used_lanes(node);
+            let mut used = node.used();
             while used != 0 {
                 let c = used.trailing_zeros() as usize;
                 used &= used - 1;
