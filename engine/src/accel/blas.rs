@@ -5,7 +5,9 @@
 //! of four ([`Tri4`], [`Sphere4`]) tested together with SIMD. A deforming mesh is refitted as
 //! its vertices move ([`Blas::update`]); under motion blur it keeps its
 //! triangles at shutter open and close and intersects them where they are
-//! at each ray's time.
+//! at each ray's time. The renderer's batches of rays go through the
+//! level two rays at a time, their traversals interleaved
+//! ([`interleave`]).
 
 use super::hierarchy::{Hierarchy, Update, UpdatePolicy};
 use super::huge::HugeArray;
@@ -115,6 +117,8 @@ macro_rules! by_flags {
         }
     };
 }
+
+mod interleave;
 
 impl Blas {
     /// Builds the hierarchy over `prims` (and, for geometry that deforms
@@ -325,7 +329,7 @@ impl Blas {
     #[inline(always)]
     fn query<'a, const MOVING: bool, const SPHERES: bool>(
         &'a self,
-        ray: &'a Ray,
+        ray: &Ray,
     ) -> Query<'a, MOVING, SPHERES> {
         let closing = self.closing.as_ref().map_or(&[][..], |c| &c.packets);
         Query::new(&self.packets, closing, ray)
@@ -553,7 +557,7 @@ struct Query<'a, const MOVING: bool, const SPHERES: bool> {
     tau: f32,
     origin: Vec3,
     dir: Vec3,
-    prep: &'a RayPrep,
+    prep: RayPrep,
     /// Number of the first primitive, added to hits.
     base: u32,
     /// [`Hit::MISS`] until something is hit.
@@ -562,14 +566,14 @@ struct Query<'a, const MOVING: bool, const SPHERES: bool> {
 
 impl<'a, const MOVING: bool, const SPHERES: bool> Query<'a, MOVING, SPHERES> {
     #[inline(always)]
-    fn new(packets: &'a [Packet], closing: &'a [Packet], ray: &'a Ray) -> Self {
+    fn new(packets: &'a [Packet], closing: &'a [Packet], ray: &Ray) -> Self {
         Self {
             packets,
             closing,
             tau: ray.tau,
             origin: ray.origin,
             dir: ray.dir,
-            prep: &ray.prep,
+            prep: ray.prep,
             base: 0,
             best: Hit::MISS,
         }
@@ -597,9 +601,9 @@ impl<const MOVING: bool, const SPHERES: bool> LeafVisitor for Query<'_, MOVING, 
                     ref tris, first, ..
                 } => {
                     let hit = if MOVING {
-                        self.tris(i, tris).closest(self.prep, tmax)
+                        self.tris(i, tris).closest(&self.prep, tmax)
                     } else {
-                        tris.closest(self.prep, tmax)
+                        tris.closest(&self.prep, tmax)
                     };
                     if let Some(h) = hit {
                         tmax = h.t;
@@ -639,9 +643,9 @@ impl<const MOVING: bool, const SPHERES: bool> LeafVisitor for Query<'_, MOVING, 
             let hit = match self.packets[i] {
                 Packet::Triangles { ref tris, .. } => {
                     if MOVING {
-                        self.tris(i, tris).any(self.prep, tmax)
+                        self.tris(i, tris).any(&self.prep, tmax)
                     } else {
-                        tris.any(self.prep, tmax)
+                        tris.any(&self.prep, tmax)
                     }
                 }
                 Packet::Spheres { ref spheres, .. } if SPHERES => {

@@ -565,6 +565,8 @@ impl Accel {
         hits: &mut [Hit],
     ) {
         match times {
+            // One level: the rays' traversals interleaved.
+            None if self.direct => self.blases[0].closest_each::<I>(slots, origins, dirs, hits),
             None => {
                 for &slot in slots {
                     let i = slot as usize;
@@ -591,6 +593,7 @@ impl Accel {
         blocked: &mut [bool],
     ) {
         match times {
+            None if self.direct => self.blases[0].any_each::<I>(origins, dirs, tmax, blocked),
             None => {
                 for ((b, &o), &d) in blocked.iter_mut().zip(origins).zip(dirs) {
                     *b = self.any_with::<I>(o, d, tmax, 0.0);

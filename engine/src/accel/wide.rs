@@ -16,6 +16,12 @@
 //! bitonic network over the eight lanes' distances, shadow rays packed in
 //! lane order by a permutation table.
 //!
+//! A traversal is a loop of node visits ([`WideBvh::closest_step`],
+//! [`WideBvh::any_step`]) over its state between two visits, a [`Walk`]:
+//! one ray's query loops until its walk is over, and a batch query keeps
+//! two walks and steps them in turn (`blas.rs`), so that while one ray
+//! waits for its next node to arrive from memory the other's visit runs.
+//!
 //! Box tests follow Ize's "Robust BVH Ray Traversal" (2013): the far
 //! distance is enlarged by the worst-case rounding error of the slab test,
 //! so a box never misses a ray that touches it, flat boxes (axis-aligned
@@ -148,6 +154,38 @@ impl Node {
 struct Entry {
     node: u32,
     t: f32,
+}
+
+/// A traversal between two node visits ([`WideBvh::closest_step`],
+/// [`WideBvh::any_step`]): the node to visit next, the nodes waiting, and
+/// how far hits count. A batch query keeps several walks and steps them in
+/// turn, so that one ray's cache misses overlap the others' work.
+pub struct Walk {
+    stack: Stack,
+    current: usize,
+    /// Hits count within this distance: the closest so far, for a
+    /// closest-hit walk.
+    pub tmax: f32,
+}
+
+impl Walk {
+    /// A walk from the root, for hits within `tmax`.
+    #[inline(always)]
+    pub fn new(tmax: f32) -> Self {
+        Self {
+            stack: Stack::new(),
+            current: 0,
+            tmax,
+        }
+    }
+
+    /// Starts over from the root, for hits within `tmax`.
+    #[inline(always)]
+    pub fn restart(&mut self, tmax: f32) {
+        self.stack.len = 0;
+        self.current = 0;
+        self.tmax = tmax;
+    }
 }
 
 /// A fixed-capacity stack of entries that lives on the call stack and is
@@ -799,52 +837,66 @@ impl WideBvh {
     /// nearest first, with [`LeafVisitor::closest`]; boxes beyond the
     /// closest hit so far are skipped.
     #[inline(always)]
-    pub fn closest<I: Isa>(&self, ray: &RayBoxes, mut tmax: f32, leaf: &mut impl LeafVisitor) {
+    pub fn closest<I: Isa>(&self, ray: &RayBoxes, tmax: f32, leaf: &mut impl LeafVisitor) {
         if self.nodes.is_empty() {
             return;
         }
-        let mut stack = Stack::new();
-        let mut current = 0;
+        let mut walk = Walk::new(tmax);
+        while self.closest_step::<I>(ray, &mut walk, leaf) {}
+    }
+
+    /// One node visit of [`Self::closest`] for the walk `walk`, whose
+    /// `tmax` it lowers to each hit; `false` once the traversal is over.
+    /// The hierarchy must not be empty.
+    #[inline(always)]
+    pub fn closest_step<I: Isa>(
+        &self,
+        ray: &RayBoxes,
+        walk: &mut Walk,
+        leaf: &mut impl LeafVisitor,
+    ) -> bool {
+        let node = self.node(walk.current);
+        let mut tmax = walk.tmax;
+        let (mask, t_near) = ray.test::<I>(node, tmax);
+        // Leaves nearest first, until the next one starts beyond the hit.
+        let leaf_lanes = node.leaves();
+        let mut leaves = mask & leaf_lanes;
+        while leaves != 0 {
+            let mut lane = leaves.trailing_zeros() as usize;
+            let mut rest = leaves & (leaves - 1);
+            while rest != 0 {
+                let other = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                if t_near[other] < t_near[lane] {
+                    lane = other;
+                }
+            }
+            if t_near[lane] > tmax * FAR_SCALE {
+                break;
+            }
+            leaves &= !(1 << lane);
+            tmax = leaf.closest(node.items(lane), tmax);
+        }
+        walk.tmax = tmax;
+        let inner = mask & !leaf_lanes;
+        if inner != 0 && inner & (inner - 1) == 0 {
+            // One child: straight down, without the stack's round trip.
+            let lane = inner.trailing_zeros() as usize;
+            if t_near[lane] <= tmax * FAR_SCALE {
+                walk.current = node.child[lane] as usize;
+                return true;
+            }
+        } else if inner != 0 {
+            walk.stack.push::<I>(node, inner, &t_near, true);
+        }
+        // Next: the nearest pending node that is not beyond the hit.
         loop {
-            let node = self.node(current);
-            let (mask, t_near) = ray.test::<I>(node, tmax);
-            // Leaves nearest first, until the next one starts beyond the hit.
-            let leaf_lanes = node.leaves();
-            let mut leaves = mask & leaf_lanes;
-            while leaves != 0 {
-                let mut lane = leaves.trailing_zeros() as usize;
-                let mut rest = leaves & (leaves - 1);
-                while rest != 0 {
-                    let other = rest.trailing_zeros() as usize;
-                    rest &= rest - 1;
-                    if t_near[other] < t_near[lane] {
-                        lane = other;
-                    }
-                }
-                if t_near[lane] > tmax * FAR_SCALE {
-                    break;
-                }
-                leaves &= !(1 << lane);
-                tmax = leaf.closest(node.items(lane), tmax);
-            }
-            let inner = mask & !leaf_lanes;
-            if inner != 0 && inner & (inner - 1) == 0 {
-                // One child: straight down, without the stack's round trip.
-                let lane = inner.trailing_zeros() as usize;
-                if t_near[lane] <= tmax * FAR_SCALE {
-                    current = node.child[lane] as usize;
-                    continue;
-                }
-            } else if inner != 0 {
-                stack.push::<I>(node, inner, &t_near, true);
-            }
-            // Next: the nearest pending node that is not beyond the hit.
-            loop {
-                let Some(e) = stack.pop() else { return };
-                if e.t <= tmax * FAR_SCALE {
-                    current = e.node as usize;
-                    break;
-                }
+            let Some(e) = walk.stack.pop() else {
+                return false;
+            };
+            if e.t <= tmax * FAR_SCALE {
+                walk.current = e.node as usize;
+                return true;
             }
         }
     }
@@ -856,25 +908,44 @@ impl WideBvh {
         if self.nodes.is_empty() {
             return false;
         }
-        let mut stack = Stack::new();
-        let mut current = 0;
+        let mut walk = Walk::new(tmax);
         loop {
-            let node = self.node(current);
-            let (mask, t_near) = ray.test::<I>(node, tmax);
-            let leaf_lanes = node.leaves();
-            let mut leaves = mask & leaf_lanes;
-            while leaves != 0 {
-                let lane = leaves.trailing_zeros() as usize;
-                leaves &= leaves - 1;
-                if leaf.any(node.items(lane), tmax) {
-                    return true;
-                }
+            if let Some(hit) = self.any_step::<I>(ray, &mut walk, leaf) {
+                return hit;
             }
-            stack.push::<I>(node, mask & !leaf_lanes, &t_near, false);
-            match stack.pop_node() {
-                Some(node) => current = node as usize,
-                None => return false,
+        }
+    }
+
+    /// One node visit of [`Self::any`] for the walk `walk` (whose `tmax`
+    /// stays fixed): `Some` once the traversal is over, with whether
+    /// something was hit; `None` while it goes on. The hierarchy must not
+    /// be empty.
+    #[inline(always)]
+    pub fn any_step<I: Isa>(
+        &self,
+        ray: &RayBoxes,
+        walk: &mut Walk,
+        leaf: &mut impl LeafVisitor,
+    ) -> Option<bool> {
+        let node = self.node(walk.current);
+        let (mask, t_near) = ray.test::<I>(node, walk.tmax);
+        let leaf_lanes = node.leaves();
+        let mut leaves = mask & leaf_lanes;
+        while leaves != 0 {
+            let lane = leaves.trailing_zeros() as usize;
+            leaves &= leaves - 1;
+            if leaf.any(node.items(lane), walk.tmax) {
+                return Some(true);
             }
+        }
+        walk.stack
+            .push::<I>(node, mask & !leaf_lanes, &t_near, false);
+        match walk.stack.pop_node() {
+            Some(node) => {
+                walk.current = node as usize;
+                None
+            }
+            None => Some(false),
         }
     }
 }
