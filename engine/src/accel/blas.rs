@@ -119,6 +119,7 @@ macro_rules! by_flags {
 }
 
 mod interleave;
+pub(super) use interleave::Lane;
 
 impl Blas {
     /// Builds the hierarchy over `prims` (and, for geometry that deforms
@@ -225,6 +226,12 @@ impl Blas {
     /// Whether the primitives move while the shutter is open.
     pub fn deforms(&self) -> bool {
         self.closing.is_some()
+    }
+
+    /// The flags its queries are compiled with ([`by_flags!`]): whether
+    /// it moves under the shutter, whether it holds spheres.
+    pub(super) fn flags(&self) -> (bool, bool) {
+        (self.closing.is_some(), self.spheres)
     }
 
     /// The hierarchy (for its SAH cost and bounds).
@@ -551,7 +558,7 @@ fn closing(close: &[Primitive], order: &[u32], open: &[Packet]) -> Closing {
 /// without spheres (`!SPHERES`) no sphere test: its packets are all
 /// triangles, and the ray's origin and direction, which only the sphere
 /// test reads, need no registers.
-struct Query<'a, const MOVING: bool, const SPHERES: bool> {
+pub(in crate::accel) struct Query<'a, const MOVING: bool, const SPHERES: bool> {
     packets: &'a [Packet],
     closing: &'a [Packet],
     tau: f32,

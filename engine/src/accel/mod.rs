@@ -27,6 +27,8 @@ mod coherent;
 pub mod hierarchy;
 mod huge;
 pub mod instance;
+mod instanced;
+mod interleave;
 pub mod offset;
 pub mod prefetch;
 pub mod sphere;
@@ -179,6 +181,19 @@ impl Level {
     fn detected() -> Level {
         Level::supported().pop().unwrap_or(Level::Baseline)
     }
+}
+
+/// `$accel.$method::<$isa, MOVING, SPHERES>(args)` for the flags
+/// `(MOVING, SPHERES)` in `$flags`.
+macro_rules! by_flag_pair {
+    ($flags:expr, $accel:ident.$method:ident::<$isa:ident>($($arg:expr),*)) => {
+        match $flags {
+            (false, false) => $accel.$method::<$isa, false, false>($($arg),*),
+            (false, true) => $accel.$method::<$isa, false, true>($($arg),*),
+            (true, false) => $accel.$method::<$isa, true, false>($($arg),*),
+            (true, true) => $accel.$method::<$isa, true, true>($($arg),*),
+        }
+    };
 }
 
 /// `$accel.$with::<I>(args)` for the instruction set of `$accel.level`:
@@ -565,7 +580,9 @@ impl Accel {
         hits: &mut [Hit],
     ) {
         match times {
-            // One level: the rays' traversals interleaved.
+            // One level without shutter times: the rays' traversals
+            // interleaved. (Through a top level, interleaved closest-hit
+            // walks were measured slower: `instanced.rs`.)
             None if self.direct => self.blases[0].closest_each::<I>(slots, origins, dirs, hits),
             None => {
                 for &slot in slots {
@@ -592,20 +609,40 @@ impl Accel {
         tmax: f32,
         blocked: &mut [bool],
     ) {
-        match times {
-            None if self.direct => self.blases[0].any_each::<I>(origins, dirs, tmax, blocked),
-            None => {
+        // Without shutter times the rays' traversals are interleaved: of
+        // the one level, or through the top level where the bottom levels
+        // share their flags.
+        let flags = self.interleaved_flags(times);
+        match (times, flags) {
+            (None, _) if self.direct => self.blases[0].any_each::<I>(origins, dirs, tmax, blocked),
+            (None, Some(flags)) => by_flag_pair!(
+                flags,
+                self.any_each_instanced::<I>(origins, dirs, tmax, blocked)
+            ),
+            (None, None) => {
                 for ((b, &o), &d) in blocked.iter_mut().zip(origins).zip(dirs) {
                     *b = self.any_with::<I>(o, d, tmax, 0.0);
                 }
             }
-            Some(times) => {
+            (Some(times), _) => {
                 let rays = origins.iter().zip(dirs).zip(times);
                 for (b, ((&o, &d), &tau)) in blocked.iter_mut().zip(rays) {
                     *b = self.any_with::<I>(o, d, tmax, tau);
                 }
             }
         }
+    }
+
+    /// The bottom levels' flags where a batch without shutter `times`
+    /// goes through the top level interleaved ([`instanced`]): the flags
+    /// every bottom level shares, if they do and the top level is not
+    /// empty.
+    #[inline(always)]
+    fn interleaved_flags(&self, times: Option<&[f32]>) -> Option<(bool, bool)> {
+        if times.is_some() || self.direct || self.tlas.wide.is_empty() {
+            return None;
+        }
+        self.uniform_flags()
     }
 
     /// Queries run the traversal compiled for `level` from now on (to
@@ -769,15 +806,28 @@ impl<I: Isa> TopQuery<'_, I> {
     /// the instance cannot be entered (a singular transform).
     #[inline(always)]
     fn enter(&self, entry: &TopEntry) -> Option<(Vec3, Vec3, f32)> {
+        self.accel.enter(entry, self.origin, self.dir, self.tau)
+    }
+}
+
+impl Accel {
+    /// The ray `origin + t·dir` in `entry`'s instance space at shutter
+    /// time `tau`: origin, direction and how far the origin moved along
+    /// the ray; `None` where the instance cannot be entered (a singular
+    /// transform).
+    #[inline(always)]
+    fn enter(
+        &self,
+        entry: &TopEntry,
+        origin: Vec3,
+        dir: Vec3,
+        tau: f32,
+    ) -> Option<(Vec3, Vec3, f32)> {
         match entry.kind() {
-            EntryKind::Identity => Some((self.origin, self.dir, 0.0)),
-            EntryKind::Fixed => Some(instance::ray_to_object(
-                &entry.transform(),
-                self.origin,
-                self.dir,
-            )),
-            EntryKind::Moving => match &self.accel.instances[entry.inst() as usize].place {
-                Place::Moving(m) => Some(m.at(self.tau)?.ray_to_object(self.origin, self.dir)),
+            EntryKind::Identity => Some((origin, dir, 0.0)),
+            EntryKind::Fixed => Some(instance::ray_to_object(&entry.transform(), origin, dir)),
+            EntryKind::Moving => match &self.instances[entry.inst() as usize].place {
+                Place::Moving(m) => Some(m.at(tau)?.ray_to_object(origin, dir)),
                 _ => None,
             },
         }

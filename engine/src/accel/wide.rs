@@ -188,6 +188,48 @@ impl Walk {
     }
 }
 
+/// What an any-hit visit's box test found ([`WideBvh::visit`]): the
+/// node, the leaves and the inner children the ray reaches, and the
+/// distances at which it enters their boxes. The visit takes the leaves
+/// in lane order ([`Visit::any_leaf`]), then goes on to the next node
+/// ([`Visit::descend_any`]), and may be left between the two (a shadow
+/// ray's batch through a top level enters a leaf's instances at later
+/// steps).
+pub struct Visit<'a> {
+    node: &'a Node,
+    leaves: u32,
+    inner: u32,
+    t_near: [f32; WIDTH],
+}
+
+impl Visit<'_> {
+    /// The items of the next leaf in lane order not yet taken.
+    #[inline(always)]
+    pub fn any_leaf(&mut self) -> Option<Range<usize>> {
+        if self.leaves == 0 {
+            return None;
+        }
+        let lane = self.leaves.trailing_zeros() as usize;
+        self.leaves &= self.leaves - 1;
+        Some(self.node.items(lane))
+    }
+
+    /// Moves an any-hit `walk` on to the next pending node; `false` where
+    /// none is left.
+    #[inline(always)]
+    pub fn descend_any<I: Isa>(&self, walk: &mut Walk) -> bool {
+        walk.stack
+            .push::<I>(self.node, self.inner, &self.t_near, false);
+        match walk.stack.pop_node() {
+            Some(node) => {
+                walk.current = node as usize;
+                true
+            }
+            None => false,
+        }
+    }
+}
+
 /// A fixed-capacity stack of entries that lives on the call stack and is
 /// not initialised up front (a ray touches only its first few slots).
 /// Structure-of-arrays, so that the AVX2 traversal writes a node's eight
@@ -901,6 +943,21 @@ impl WideBvh {
         }
     }
 
+    /// The box test of the node `walk` is at: what an any-hit visit goes
+    /// on with. The hierarchy must not be empty.
+    #[inline(always)]
+    pub fn visit<I: Isa>(&self, ray: &RayBoxes, walk: &Walk) -> Visit<'_> {
+        let node = self.node(walk.current);
+        let (mask, t_near) = ray.test::<I>(node, walk.tmax);
+        let leaf_lanes = node.leaves();
+        Visit {
+            node,
+            leaves: mask & leaf_lanes,
+            inner: mask & !leaf_lanes,
+            t_near,
+        }
+    }
+
     /// Visits the leaves that `ray` may hit in (0, `tmax`) until
     /// [`LeafVisitor::any`] reports a hit; returns whether one did.
     #[inline(always)]
@@ -927,25 +984,16 @@ impl WideBvh {
         walk: &mut Walk,
         leaf: &mut impl LeafVisitor,
     ) -> Option<bool> {
-        let node = self.node(walk.current);
-        let (mask, t_near) = ray.test::<I>(node, walk.tmax);
-        let leaf_lanes = node.leaves();
-        let mut leaves = mask & leaf_lanes;
-        while leaves != 0 {
-            let lane = leaves.trailing_zeros() as usize;
-            leaves &= leaves - 1;
-            if leaf.any(node.items(lane), walk.tmax) {
+        let mut visit = self.visit::<I>(ray, walk);
+        while let Some(items) = visit.any_leaf() {
+            if leaf.any(items, walk.tmax) {
                 return Some(true);
             }
         }
-        walk.stack
-            .push::<I>(node, mask & !leaf_lanes, &t_near, false);
-        match walk.stack.pop_node() {
-            Some(node) => {
-                walk.current = node as usize;
-                None
-            }
-            None => Some(false),
+        if visit.descend_any::<I>(walk) {
+            None
+        } else {
+            Some(false)
         }
     }
 }

@@ -1,112 +1,39 @@
-//! Batch queries of one bottom level: the traversals of two rays
-//! interleaved node visit by node visit.
-//!
-//! A traversal is a chain of dependent loads: a node's box test decides
-//! which node to load next, so a ray whose next node is not cached waits
-//! for it, and a batch loop's next ray starts only when it is done. The
-//! batch queries here ([`Blas::closest_each`], [`Blas::any_each`]) keep
-//! [`WALKS`] rays in lanes, each with its query and its [`Walk`], and
-//! step them in turn ([`interleave`]): while one ray's node is on its way
-//! the other's visit runs. Each ray gets the answer of its own traversal,
-//! bit for bit what [`Blas::closest`] and [`Blas::any`] give it.
-//!
-//! Two lanes, measured: renders of the suite's scenes (meshes that mostly
-//! stay cached) run 2–4 % faster than with one ray at a time, and three or
-//! four lanes' bookkeeping costs what they gain; incoherent rays and
-//! scenes far larger than the caches gain more (see
-//! `engine/benches/ANIMATION.md`).
+//! Batch queries of one bottom level (a one-level scene): the rays'
+//! traversals interleaved node visit by node visit ([`interleave`]). Each
+//! ray gets the answer of its own traversal, bit for bit what
+//! [`Blas::closest`] and [`Blas::any`] give it.
 
 use super::{Blas, Query, Ray};
+use crate::accel::interleave::{Walks, interleave};
 use crate::accel::wide::{Isa, RayBoxes, Walk};
 use crate::accel::{Hit, ray_is_valid};
 use glam::Vec3;
 use std::marker::PhantomData;
 
-/// Rays a batch query traces at once.
-const WALKS: usize = 2;
-
-/// One ray of a batch query: its query of the leaves, its box-test
-/// constants and its traversal so far.
-struct Lane<'a, const MOVING: bool, const SPHERES: bool> {
-    query: Query<'a, MOVING, SPHERES>,
-    boxes: RayBoxes,
-    walk: Walk,
+/// One ray of a one-level batch query: its query of the leaves, its
+/// box-test constants and its traversal so far. A two-level query keeps
+/// one for the instance a ray is in.
+pub(in crate::accel) struct Lane<'a, const MOVING: bool, const SPHERES: bool> {
+    pub(in crate::accel) query: Query<'a, MOVING, SPHERES>,
+    pub(in crate::accel) boxes: RayBoxes,
+    pub(in crate::accel) walk: Walk,
     /// Whether an any-hit walk found a hit.
     hit: bool,
 }
 
-/// What a batch query does with its lanes ([`interleave`]).
-trait Walks<'a, const MOVING: bool, const SPHERES: bool> {
-    /// A ray's answer.
-    type Answer;
-
-    /// An idle lane.
-    fn lane(&self) -> Lane<'a, MOVING, SPHERES>;
-
-    /// Sets `lane` up for ray `i`; or returns the ray's answer where it
-    /// needs no traversal.
-    fn start(&self, lane: &mut Lane<'a, MOVING, SPHERES>, i: usize) -> Option<Self::Answer>;
-
-    /// One node visit of `lane`'s walk; whether it goes on.
-    fn step(&self, lane: &mut Lane<'a, MOVING, SPHERES>) -> bool;
-
-    /// The answer of `lane`, whose walk is over.
-    fn finish(&self, lane: &Lane<'a, MOVING, SPHERES>) -> Self::Answer;
-}
-
-/// Answers the rays `rays` into `out` with `walks`, [`WALKS`] rays at a
-/// time whose traversals go one node visit each in turn: a traversal is a
-/// chain of dependent loads, and while one ray waits for its next node the
-/// others' visits run. Each ray gets the answer of its own traversal,
-/// whatever order the rays finish in.
-#[inline(always)]
-fn interleave<'a, W: Walks<'a, MOVING, SPHERES>, const MOVING: bool, const SPHERES: bool>(
-    walks: &W,
-    mut rays: impl Iterator<Item = usize>,
-    out: &mut [W::Answer],
-) {
-    let mut lanes: [Lane<'a, MOVING, SPHERES>; WALKS] = std::array::from_fn(|_| walks.lane());
-    let mut of: [Option<usize>; WALKS] = [None; WALKS];
-    let mut busy = 0;
-    loop {
-        for (lane, ray) in lanes.iter_mut().zip(&mut of) {
-            if let Some(i) = *ray {
-                if walks.step(lane) {
-                    continue;
-                }
-                out[i] = walks.finish(lane);
-                *ray = None;
-                busy -= 1;
-            }
-            for i in rays.by_ref() {
-                match walks.start(lane, i) {
-                    Some(answer) => out[i] = answer,
-                    None => {
-                        *ray = Some(i);
-                        busy += 1;
-                        break;
-                    }
-                }
-            }
-        }
-        if busy == 0 {
-            return;
-        }
-    }
-}
-
 /// Closest-hit walks of the rays `origins[i] + t·dirs[i]`, t > 0, at
 /// shutter time 0.
-struct ClosestWalks<'a, I> {
+struct ClosestWalks<'a, I, const MOVING: bool, const SPHERES: bool> {
     blas: &'a Blas,
     origins: &'a [Vec3],
     dirs: &'a [Vec3],
     isa: PhantomData<I>,
 }
 
-impl<'a, I: Isa, const MOVING: bool, const SPHERES: bool> Walks<'a, MOVING, SPHERES>
-    for ClosestWalks<'a, I>
+impl<'a, I: Isa, const MOVING: bool, const SPHERES: bool> Walks
+    for ClosestWalks<'a, I, MOVING, SPHERES>
 {
+    type Lane = Lane<'a, MOVING, SPHERES>;
     type Answer = Hit;
 
     #[inline(always)]
@@ -139,7 +66,7 @@ impl<'a, I: Isa, const MOVING: bool, const SPHERES: bool> Walks<'a, MOVING, SPHE
 
 /// Any-hit walks of the rays `origins[j] + t·dirs[j]`, t in (0, `tmax`),
 /// at shutter time 0.
-struct AnyWalks<'a, I> {
+struct AnyWalks<'a, I, const MOVING: bool, const SPHERES: bool> {
     blas: &'a Blas,
     origins: &'a [Vec3],
     dirs: &'a [Vec3],
@@ -147,9 +74,10 @@ struct AnyWalks<'a, I> {
     isa: PhantomData<I>,
 }
 
-impl<'a, I: Isa, const MOVING: bool, const SPHERES: bool> Walks<'a, MOVING, SPHERES>
-    for AnyWalks<'a, I>
+impl<'a, I: Isa, const MOVING: bool, const SPHERES: bool> Walks
+    for AnyWalks<'a, I, MOVING, SPHERES>
 {
+    type Lane = Lane<'a, MOVING, SPHERES>;
     type Answer = bool;
 
     #[inline(always)]
@@ -190,7 +118,7 @@ impl Blas {
     /// The closest hits of the rays `origins[i] + t·dirs[i]` (t > 0) of
     /// `slots` at shutter time 0, their primitives numbered from 0, into
     /// `hits[i]` ([`Hit::MISS`] where none): [`Blas::closest`] for each,
-    /// [`WALKS`] rays at a time, their traversals interleaved node visit by
+    /// [`WALKS`](crate::accel::interleave) rays at a time, their traversals interleaved node visit by
     /// node visit so that one ray's cache misses overlap the others' work.
     #[inline(always)]
     pub(in crate::accel) fn closest_each<I: Isa>(
@@ -219,14 +147,14 @@ impl Blas {
         (origins, dirs): (&[Vec3], &[Vec3]),
         hits: &mut [Hit],
     ) {
-        let walks = ClosestWalks::<I> {
+        let walks = ClosestWalks::<I, MOVING, SPHERES> {
             blas: self,
             origins,
             dirs,
             isa: PhantomData,
         };
         let rays = slots.iter().map(|&slot| slot as usize);
-        interleave::<_, MOVING, SPHERES>(&walks, rays, hits);
+        interleave(&walks, rays, hits);
     }
 
     /// Whether anything blocks each ray `origins[j] + t·dirs[j]`, t in
@@ -257,7 +185,7 @@ impl Blas {
         tmax: f32,
         blocked: &mut [bool],
     ) {
-        let walks = AnyWalks::<I> {
+        let walks = AnyWalks::<I, MOVING, SPHERES> {
             blas: self,
             origins,
             dirs,
@@ -265,12 +193,14 @@ impl Blas {
             isa: PhantomData,
         };
         let n = blocked.len().min(origins.len()).min(dirs.len());
-        interleave::<_, MOVING, SPHERES>(&walks, 0..n, blocked);
+        interleave(&walks, 0..n, blocked);
     }
 
     /// An idle lane of a batch query ([`interleave`]).
     #[inline(always)]
-    fn lane<I: Isa, const MOVING: bool, const SPHERES: bool>(&self) -> Lane<'_, MOVING, SPHERES> {
+    pub(in crate::accel) fn lane<I: Isa, const MOVING: bool, const SPHERES: bool>(
+        &self,
+    ) -> Lane<'_, MOVING, SPHERES> {
         let ray = Ray::new::<I>(Vec3::X, Vec3::X, 0.0);
         Lane {
             query: self.query::<MOVING, SPHERES>(&ray),
@@ -283,7 +213,7 @@ impl Blas {
     /// Sets `lane` up for the ray `origin + t·dir` at shutter time 0 with
     /// hits within `tmax`, in place (a new lane would copy its stack).
     #[inline(always)]
-    fn restart<'a, I: Isa, const MOVING: bool, const SPHERES: bool>(
+    pub(in crate::accel) fn restart<'a, I: Isa, const MOVING: bool, const SPHERES: bool>(
         &'a self,
         lane: &mut Lane<'a, MOVING, SPHERES>,
         origin: Vec3,
@@ -300,7 +230,7 @@ impl Blas {
 
 #[cfg(test)]
 mod tests {
-    use crate::accel::tests::{lcg, object};
+    use crate::accel::tests::{lcg, object, placements, swing, two_levels};
     use crate::accel::{Accel, Blas, BuildQuality, Hit, Instance, Level, Place, Primitive};
     use glam::Vec3;
 
@@ -318,9 +248,54 @@ mod tests {
             .collect()
     }
 
-    /// One-level accelerators of every kind the batch queries compile
-    /// for: triangles alone, triangles and spheres, a deforming level
-    /// (queried at shutter open), and nothing.
+    /// Accelerators of every kind the batch queries compile for. One
+    /// level: triangles alone, triangles and spheres, a deforming level
+    /// (queried at shutter open), and nothing. Two levels: turned
+    /// instances of triangles over static shapes, the same with a moving
+    /// instance (at shutter open), and levels of which only some hold
+    /// spheres (which the batches trace ray by ray).
+    fn accels() -> Vec<(&'static str, Accel)> {
+        let mut all = levels();
+        let shape = object(9, 300);
+        let tris: Vec<Primitive> = shape
+            .iter()
+            .filter(|p| matches!(p, Primitive::Triangle(_)))
+            .copied()
+            .collect();
+        let statics = object(11, 200);
+        let statics_tris: Vec<Primitive> = statics
+            .iter()
+            .filter(|p| matches!(p, Primitive::Triangle(_)))
+            .copied()
+            .collect();
+        let places = placements(13, 40);
+        let scaled: Vec<glam::DMat4> = places
+            .iter()
+            .map(|m| glam::DMat4::from_scale(glam::DVec3::splat(0.25)) * *m)
+            .collect();
+        let (blases, instances) = two_levels(&statics_tris, &tris, &scaled);
+        all.push((
+            "turned instances",
+            Accel::new(blases, instances, BuildQuality::High),
+        ));
+        let (blases, mut instances) = two_levels(&statics, &shape, &scaled);
+        instances.push(Instance {
+            blas: 1,
+            place: Place::Moving(Box::new(swing())),
+        });
+        all.push((
+            "spheres and a moving instance",
+            Accel::new(blases, instances, BuildQuality::Medium),
+        ));
+        let (blases, instances) = two_levels(&statics_tris, &shape, &scaled);
+        all.push((
+            "mixed levels",
+            Accel::new(blases, instances, BuildQuality::Medium),
+        ));
+        all
+    }
+
+    /// The one-level accelerators of [`accels`].
     fn levels() -> Vec<(&'static str, Accel)> {
         let mixed = object(5, 3000);
         let triangles: Vec<Primitive> = mixed
@@ -401,7 +376,7 @@ mod tests {
             b1: 0.5,
             b2: 0.5,
         };
-        for (name, mut accel) in levels() {
+        for (name, mut accel) in accels() {
             let mut hit_count = 0;
             for level in Level::supported() {
                 accel.use_level(level);
