@@ -19,8 +19,11 @@
 //! A traversal is a loop of node visits ([`WideBvh::closest_step`],
 //! [`WideBvh::any_step`]) over its state between two visits, a [`Walk`]:
 //! one ray's query loops until its walk is over, and a batch query keeps
-//! two walks and steps them in turn (`blas.rs`), so that while one ray
-//! waits for its next node to arrive from memory the other's visit runs.
+//! two walks and steps them in turn (`accel/interleave.rs`), so that while
+//! one ray waits for its next node to arrive from memory the other's
+//! visit runs. A shadow ray's visit can also be taken apart ([`Visit`]),
+//! so that a walk through a top level can stop between the instances a
+//! node's leaves lead to.
 //!
 //! Box tests follow Ize's "Robust BVH Ray Traversal" (2013): the far
 //! distance is enlarged by the worst-case rounding error of the slab test,
