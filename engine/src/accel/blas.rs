@@ -104,20 +104,6 @@ impl Ray {
     }
 }
 
-/// `$blas.$method::<$isa, MOVING, SPHERES>(args)` with the flags that
-/// level `$blas` needs (whether it moves under the shutter, whether it
-/// holds spheres): each combination is its own compiled query.
-macro_rules! by_flags {
-    ($blas:ident, $method:ident::<$isa:ident>($($arg:expr),*)) => {
-        match ($blas.closing.is_some(), $blas.spheres) {
-            (false, false) => $blas.$method::<$isa, false, false>($($arg),*),
-            (false, true) => $blas.$method::<$isa, false, true>($($arg),*),
-            (true, false) => $blas.$method::<$isa, true, false>($($arg),*),
-            (true, true) => $blas.$method::<$isa, true, true>($($arg),*),
-        }
-    };
-}
-
 mod interleave;
 pub(super) use interleave::Lane;
 
@@ -230,6 +216,7 @@ impl Blas {
 
     /// The flags its queries are compiled with ([`by_flags!`]): whether
     /// it moves under the shutter, whether it holds spheres.
+    #[inline(always)]
     pub(super) fn flags(&self) -> (bool, bool) {
         (self.closing.is_some(), self.spheres)
     }
@@ -293,7 +280,10 @@ impl Blas {
         if self.packets.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return Hit::MISS;
         }
-        by_flags!(self, closest_in::<I>(origin, dir, tau, tmax, base))
+        by_flags!(
+            self.flags(),
+            self.closest_in::<I>(origin, dir, tau, tmax, base)
+        )
     }
 
     /// [`Blas::closest`] with the query compiled for motion (`MOVING`) and
@@ -428,7 +418,7 @@ impl Blas {
         if self.packets.is_empty() || !ray_is_valid(origin, dir, tmax) {
             return false;
         }
-        by_flags!(self, any_in::<I>(origin, dir, tau, tmax))
+        by_flags!(self.flags(), self.any_in::<I>(origin, dir, tau, tmax))
     }
 }
 

@@ -22,6 +22,21 @@
 //! away at every scene scale without a fixed epsilon; instance transforms
 //! carry those bounds across ([`instance`]).
 
+/// `$target.$method::<$isa, MOVING, SPHERES>(args)` for the bottom-level
+/// flags `$flags` (whether a level moves under the shutter, whether it
+/// holds spheres; [`Blas::flags`]): each combination is its own compiled
+/// query.
+macro_rules! by_flags {
+    ($flags:expr, $target:ident.$method:ident::<$isa:ident>($($arg:expr),*)) => {
+        match $flags {
+            (false, false) => $target.$method::<$isa, false, false>($($arg),*),
+            (false, true) => $target.$method::<$isa, false, true>($($arg),*),
+            (true, false) => $target.$method::<$isa, true, false>($($arg),*),
+            (true, true) => $target.$method::<$isa, true, true>($($arg),*),
+        }
+    };
+}
+
 mod blas;
 mod coherent;
 pub mod hierarchy;
@@ -181,19 +196,6 @@ impl Level {
     fn detected() -> Level {
         Level::supported().pop().unwrap_or(Level::Baseline)
     }
-}
-
-/// `$accel.$method::<$isa, MOVING, SPHERES>(args)` for the flags
-/// `(MOVING, SPHERES)` in `$flags`.
-macro_rules! by_flag_pair {
-    ($flags:expr, $accel:ident.$method:ident::<$isa:ident>($($arg:expr),*)) => {
-        match $flags {
-            (false, false) => $accel.$method::<$isa, false, false>($($arg),*),
-            (false, true) => $accel.$method::<$isa, false, true>($($arg),*),
-            (true, false) => $accel.$method::<$isa, true, false>($($arg),*),
-            (true, true) => $accel.$method::<$isa, true, true>($($arg),*),
-        }
-    };
 }
 
 /// `$accel.$with::<I>(args)` for the instruction set of `$accel.level`:
@@ -615,10 +617,12 @@ impl Accel {
         let flags = self.interleaved_flags(times);
         match (times, flags) {
             (None, _) if self.direct => self.blases[0].any_each::<I>(origins, dirs, tmax, blocked),
-            (None, Some(flags)) => by_flag_pair!(
-                flags,
-                self.any_each_instanced::<I>(origins, dirs, tmax, blocked)
-            ),
+            (None, Some(flags)) => {
+                by_flags!(
+                    flags,
+                    self.any_each_instanced::<I>(origins, dirs, tmax, blocked)
+                )
+            }
             (None, None) => {
                 for ((b, &o), &d) in blocked.iter_mut().zip(origins).zip(dirs) {
                     *b = self.any_with::<I>(o, d, tmax, 0.0);

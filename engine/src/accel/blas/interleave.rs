@@ -135,7 +135,7 @@ impl Blas {
             return;
         }
         let rays = (origins, dirs);
-        by_flags!(self, closest_each_in::<I>(slots, rays, hits));
+        by_flags!(self.flags(), self.closest_each_in::<I>(slots, rays, hits));
     }
 
     /// [`Blas::closest_each`] with the query compiled for `MOVING` and
@@ -173,7 +173,7 @@ impl Blas {
             return;
         }
         let rays = (origins, dirs);
-        by_flags!(self, any_each_in::<I>(rays, tmax, blocked));
+        by_flags!(self.flags(), self.any_each_in::<I>(rays, tmax, blocked));
     }
 
     /// [`Blas::any_each`] with the query compiled for `MOVING` and
