@@ -6,7 +6,9 @@
 //! one packet (`wide::packet`): through the bottom level of a one-level
 //! scene, or through the top level and then, instance by instance, through
 //! the bottom levels of the lanes that enter each one (their rays moved to
-//! the instance's space lane by lane, exactly as a single ray's are). Each
+//! the instance's space lane by lane, exactly as a single ray's are) where
+//! the instance looks large enough from them to keep them together, else
+//! one ray at a time (`packet_pays`). Each
 //! ray gets the hit it gets alone, up to which of two primitives at
 //! exactly the same distance is named. Groups that cannot share a
 //! traversal, rays at shutter times, and CPUs without AVX2 take the
@@ -102,6 +104,7 @@ impl Accel {
             accel: self,
             origins,
             dirs,
+            spread: spread(dirs),
             best: [Hit::MISS; PACKET],
             isa: PhantomData,
         };
@@ -114,12 +117,15 @@ impl Accel {
 
 /// A packet's query of the top level: at each leaf, the lanes that reach
 /// an instance enter its space and traverse its bottom level together
-/// where they still can, one by one where not.
+/// where the instance looks large from them (`packet_pays`) and they still
+/// can, one by one where not.
 #[cfg(target_arch = "x86_64")]
 struct TopPacketQuery<'a, I> {
     accel: &'a Accel,
     origins: &'a [Vec3; PACKET],
     dirs: &'a [Vec3; PACKET],
+    /// How far apart the rays head ([`spread`]).
+    spread: f32,
     /// Each lane's closest hit so far.
     best: [Hit; PACKET],
     isa: PhantomData<I>,
@@ -161,8 +167,10 @@ impl<I: Isa> TopPacketQuery<'_, I> {
             }
         }
         let blas = &self.accel.blases[entry.blas() as usize];
-        let hits = blas
-            .closest_packet(&origins, &dirs, entered, &reach, entry.base())
+        let together = packet_pays(blas.bounds(), origins[first], self.spread);
+        let hits = together
+            .then(|| blas.closest_packet(&origins, &dirs, entered, &reach, entry.base()))
+            .flatten()
             .unwrap_or_else(|| {
                 std::array::from_fn(|lane| match entered & (1 << lane) {
                     0 => Hit::MISS,
@@ -188,6 +196,41 @@ impl<I: Isa> TopPacketQuery<'_, I> {
     }
 }
 
+/// The largest angle (in radians, about) between the first ray's
+/// direction and another's.
+#[cfg(target_arch = "x86_64")]
+fn spread(dirs: &[Vec3; PACKET]) -> f32 {
+    let first = dirs[0].normalize_or_zero();
+    dirs.iter()
+        .map(|d| (d.normalize_or_zero() - first).length())
+        .fold(0.0, f32::max)
+}
+
+/// An instance is entered by a packet where its bounding sphere's radius
+/// is more than this many times the packet's width at the sphere's centre
+/// (about its size on screen in pixels, for a pixel's camera rays).
+/// Measured (`engine/benches/ANIMATION.md`, stop 28): 4 and 64 are each
+/// worse on one of the field of bunnies and an instanced teapot.
+#[cfg(target_arch = "x86_64")]
+const PACKET_PIXELS: f32 = 16.0;
+
+/// Whether rays leaving `origin` (in the instance's space) at most
+/// `spread` apart stay together through a bottom level of bounds `bounds`:
+/// where the instance looks small from the rays, they part at its first
+/// nodes, and a packet visits the union of the nodes they visit apart.
+/// (Rotations and uniform scales keep the ratio of size to distance and the
+/// angles, so the test can run in the instance's space.)
+#[cfg(target_arch = "x86_64")]
+#[inline]
+fn packet_pays(bounds: Option<obvhs::aabb::Aabb>, origin: Vec3, spread: f32) -> bool {
+    let Some(b) = bounds else {
+        return false;
+    };
+    let centre = Vec3::from((b.min + b.max) * 0.5);
+    let radius = 0.5 * Vec3::from(b.max - b.min).length();
+    radius > PACKET_PIXELS * spread * (centre - origin).length()
+}
+
 #[cfg(target_arch = "x86_64")]
 impl<I: Isa> PacketLeafVisitor for TopPacketQuery<'_, I> {
     #[inline(always)]
@@ -197,5 +240,34 @@ impl<I: Isa> PacketLeafVisitor for TopPacketQuery<'_, I> {
             // (`Accel::closest_packet`).
             unsafe { self.instance(entry, lanes, tmax) };
         }
+    }
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use super::*;
+    use obvhs::aabb::Aabb;
+
+    #[test]
+    fn spread_is_the_widest_angle_from_the_first_ray() {
+        let mut dirs = [Vec3::Z; PACKET];
+        assert_eq!(spread(&dirs), 0.0);
+        // Lengths do not count; 0.01 rad off, the chord is about 0.01.
+        dirs[3] = Vec3::new(0.01f32.sin(), 0.0, 0.01f32.cos()) * 3.0;
+        dirs[5] = Vec3::Z * 0.5;
+        assert!((spread(&dirs) - 0.01).abs() < 1e-5, "{}", spread(&dirs));
+    }
+
+    #[test]
+    fn packets_enter_instances_that_look_large_from_them() {
+        let unit = Some(Aabb::new(Vec3::splat(-1.0).into(), Vec3::splat(1.0).into()));
+        // Radius √3; a pixel's rays 1e-3 apart.
+        let near = Vec3::new(0.0, 0.0, 10.0);
+        assert!(packet_pays(unit, near, 1e-3));
+        // A hundred times farther it spans about 1.7 packet widths.
+        assert!(!packet_pays(unit, near * 100.0, 1e-3));
+        // Identical rays always stay together; nothing to enter, never.
+        assert!(packet_pays(unit, near * 1e4, 0.0));
+        assert!(!packet_pays(None, near, 0.0));
     }
 }
