@@ -46,7 +46,8 @@ Mitsuba, repeated ``--runs`` times, each render with its own seed), on the
 same number of threads; Mitsuba's kernel is compiled in a warm-up render
 that is not timed. Radiant's time is the render time it reports, Mitsuba's
 the wall time of ``mi.render`` plus the read-back of the image. It reports
-per scene the median time of each and their ratio (speed), the MSE of each
+per scene the median time of each and their ratio per sample (speed;
+Mitsuba's ``ldsampler`` rounds the spp up to a square power of two), the MSE of each
 against the reference (mean over the runs, less the reference's variance),
 the equal-error ratio (T·MSE of Mitsuba) / (T·MSE of Radiant) and the
 geometric means over the scenes other than the Cornell box.
@@ -639,6 +640,9 @@ def cmd_bench(args):
         scene = load_scene(mi, name, s, spp, args.mitsuba_sampler)
         img = mi.render(scene, spp=spp, seed=999)  # compiles the kernel
         dr.eval(img)
+        # What Mitsuba takes: `ldsampler` rounds to a square power of two
+        # (32 becomes 64), so speeds are compared per sample.
+        m_spp = scene.sensors()[0].sampler().sample_count()
         rt, mt, rerr, merr = [], [], [], []
         out = f"/tmp/radiant-suite-{os.getpid()}.exr"
         for i in range(args.runs):
@@ -651,7 +655,7 @@ def cmd_bench(args):
             merr.append(float(np.mean((pixels - ref) ** 2)))
         r_t, m_t = statistics.median(rt), statistics.median(mt)
         r_mse, m_mse = (max(statistics.mean(e) - ref_var, 1e-30) for e in (rerr, merr))
-        rows.append((name, spp, r_t, m_t, r_mse, m_mse))
+        rows.append((name, spp, m_spp, r_t, m_t, r_mse, m_mse))
         print(f"  {name}: radiant {['%.2f' % t for t in rt]} s, mitsuba {['%.2f' % t for t in mt]}"
               f" s; MSE {r_mse:.3e} / {m_mse:.3e} (reference variance {ref_var:.1e})",
               file=sys.stderr, flush=True)
@@ -667,12 +671,14 @@ def cmd_bench(args):
     print("| scene | spp | Radiant s | Mitsuba s | speed | MSE Radiant | MSE Mitsuba | at equal error |")
     print("|---|---|---|---|---|---|---|---|")
     speeds, equal = [], []
-    for name, spp, r_t, m_t, r_mse, m_mse in rows:
-        speed, eq = m_t / r_t, (m_t * m_mse) / (r_t * r_mse)
+    for name, spp, m_spp, r_t, m_t, r_mse, m_mse in rows:
+        # Samples per second, Radiant's over Mitsuba's.
+        speed, eq = (m_t * spp) / (r_t * m_spp), (m_t * m_mse) / (r_t * r_mse)
         if name != "cornell-box":
             speeds.append(speed)
             equal.append(eq)
-        print(f"| {name} | {spp} | {r_t:.2f} | {m_t:.2f} | {speed:.2f}x | {r_mse:.3e} | "
+        spps = f"{spp}" if m_spp == spp else f"{spp} (Mitsuba {m_spp})"
+        print(f"| {name} | {spps} | {r_t:.2f} | {m_t:.2f} | {speed:.2f}x | {r_mse:.3e} | "
               f"{m_mse:.3e} | {eq:.2f}x |")
     if speeds:
         def gmean(v):
