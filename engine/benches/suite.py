@@ -46,8 +46,9 @@ Mitsuba, repeated ``--runs`` times, each render with its own seed), on the
 same number of threads; Mitsuba's kernel is compiled in a warm-up render
 that is not timed. Radiant's time is the render time it reports, Mitsuba's
 the wall time of ``mi.render`` plus the read-back of the image. It reports
-per scene the median time of each and their ratio per sample (speed;
-Mitsuba's ``ldsampler`` rounds the spp up to a square power of two), the MSE of each
+per scene the median time of each and their ratio per sample (speed:
+Mitsuba's ``stratified``, ``multijitter``, ``orthogonal`` and ``ldsampler``
+round the spp up), the MSE of each
 against the reference (mean over the runs, less the reference's variance),
 the equal-error ratio (T·MSE of Mitsuba) / (T·MSE of Radiant) and the
 geometric means over the scenes other than the Cornell box.
@@ -640,8 +641,8 @@ def cmd_bench(args):
         scene = load_scene(mi, name, s, spp, args.mitsuba_sampler)
         img = mi.render(scene, spp=spp, seed=999)  # compiles the kernel
         dr.eval(img)
-        # What Mitsuba takes: `ldsampler` rounds to a square power of two
-        # (32 becomes 64), so speeds are compared per sample.
+        # What Mitsuba takes: its stratified samplers round the spp up (32
+        # becomes 36, 35, 49 or 64), so speeds are compared per sample.
         m_spp = scene.sensors()[0].sampler().sample_count()
         rt, mt, rerr, merr = [], [], [], []
         out = f"/tmp/radiant-suite-{os.getpid()}.exr"

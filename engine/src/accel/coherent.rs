@@ -167,18 +167,17 @@ impl<I: Isa> TopPacketQuery<'_, I> {
             }
         }
         let blas = &self.accel.blases[entry.blas() as usize];
-        let together = packet_pays(blas.bounds(), origins[first], self.spread);
-        let hits = together
-            .then(|| blas.closest_packet(&origins, &dirs, entered, &reach, entry.base()))
-            .flatten()
-            .unwrap_or_else(|| {
-                std::array::from_fn(|lane| match entered & (1 << lane) {
-                    0 => Hit::MISS,
-                    _ => {
-                        blas.closest::<I>(origins[lane], dirs[lane], reach[lane], 0.0, entry.base())
-                    }
-                })
-            });
+        let packet = if packet_pays(blas.bounds(), origins[first], self.spread) {
+            blas.closest_packet(&origins, &dirs, entered, &reach, entry.base())
+        } else {
+            None
+        };
+        let hits = packet.unwrap_or_else(|| {
+            std::array::from_fn(|lane| match entered & (1 << lane) {
+                0 => Hit::MISS,
+                _ => blas.closest::<I>(origins[lane], dirs[lane], reach[lane], 0.0, entry.base()),
+            })
+        });
         let mut each = entered;
         while each != 0 {
             let lane = each.trailing_zeros() as usize;
