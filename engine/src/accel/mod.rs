@@ -369,6 +369,12 @@ impl Accel {
         &mut self.instances
     }
 
+    /// Whether queries go through a top level (more than one instance, or
+    /// one that is placed), rather than straight to one bottom level.
+    pub fn has_top_level(&self) -> bool {
+        !self.direct
+    }
+
     /// The instances.
     pub fn instances(&self) -> &[Instance] {
         &self.instances

@@ -16,6 +16,11 @@ const LINE: usize = 64;
 /// Starts loading every cache line of `value` into the first-level data
 /// cache, without waiting for it (a hint: it changes no result, and does
 /// nothing on targets without a prefetch instruction).
+///
+/// One prefetch per 64 bytes of the value from its start, and one at its
+/// last byte: that reaches every line the value touches, wherever it
+/// starts, with a number of instructions fixed by its type (no loop over
+/// its alignment at run time).
 #[inline(always)]
 pub fn prefetch<T>(value: &T) {
     #[cfg(target_arch = "x86_64")]
@@ -23,15 +28,15 @@ pub fn prefetch<T>(value: &T) {
         use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
         let start = std::ptr::from_ref(value).cast::<i8>();
         let size = std::mem::size_of::<T>();
-        // The first line, and one per line boundary the value crosses.
-        let skew = start as usize % LINE;
         let mut offset = 0;
-        while offset < size + skew {
-            // A prefetch never faults, so the last address may lie past
-            // the value's end (in its last line).
+        while offset < size {
             // SAFETY: prefetching reads nothing and never faults.
             unsafe { _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(offset)) };
             offset += LINE;
+        }
+        if size > 1 {
+            // SAFETY: as above.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(size - 1)) };
         }
     }
     #[cfg(not(target_arch = "x86_64"))]

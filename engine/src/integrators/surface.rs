@@ -76,18 +76,36 @@ fn above_tangent_plane(ns: Vec3, ng: Vec3) -> Vec3 {
 pub const PREFETCH_AHEAD: usize = 8;
 
 /// Bytes of hit records (primitives, their shading records, instance
-/// records) above which [`prefetch`] pays: beyond about half a core's
-/// second-level cache a hit's records are rarely cached, below it asking
-/// for them only costs instructions (6 % of the Cornell box's time).
+/// records) above which [`prefetch`] pays where hits go through a top
+/// level: each record is then reached through its instance's, a chain of
+/// two loads that asking ahead takes apart (the field of 10,000 bunnies,
+/// 9 MB of records, renders 6 % faster). Below about half a core's
+/// second-level cache asking only costs instructions (6 % of the Cornell
+/// box's time).
 const PREFETCH_ABOVE: usize = 1 << 20;
 
+/// [`PREFETCH_ABOVE`] for hits in one bottom level, whose records are
+/// reached in one load: asking ahead costs about 80 instructions a hit,
+/// which pay only where the records are far larger than the caches. Of
+/// the one-level scenes measured, the 2.4 million triangles of the
+/// 25-mesh grid (270 MB of records) render 4 % faster with it, the
+/// plastic-pane ogre (124,000 triangles, 14 MB) 2–4 % slower and the
+/// bunny (7.8 MB) no faster (`engine/benches/SUITE.md`, stop 29).
+const PREFETCH_ABOVE_ONE_LEVEL: usize = 64 << 20;
+
 /// Whether a batch stage should [`prefetch`] the records of `scene`'s
-/// hits: whether they take more than [`PREFETCH_ABOVE`].
+/// hits: whether they take more than [`PREFETCH_ABOVE`], or
+/// [`PREFETCH_ABOVE_ONE_LEVEL`] where there is no top level.
 pub fn prefetch_pays(scene: &RenderScene) -> bool {
     use std::mem::{size_of, size_of_val};
     let per_primitive = size_of::<Primitive>() + size_of::<[Vec3; 3]>() + size_of::<Frame>();
     let bytes = scene.surfaces.normals.len() * per_primitive + size_of_val(scene.accel.instances());
-    bytes > PREFETCH_ABOVE
+    let above = if scene.accel.has_top_level() {
+        PREFETCH_ABOVE
+    } else {
+        PREFETCH_ABOVE_ONE_LEVEL
+    };
+    bytes > above
 }
 
 /// Starts loading what resolving `hit` reads, in two steps: `far` is hit
