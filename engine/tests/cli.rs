@@ -1002,3 +1002,46 @@ fn strategies_refuses_what_it_cannot_split() {
         );
     }
 }
+
+/// `--max-isa` caps the traversal's instruction set without changing the
+/// image: the baseline's render is byte for byte the widest one's (the
+/// levels give the same hits). An unknown set is refused with the allowed
+/// ones, before anything is written.
+#[test]
+fn the_instruction_set_limit_keeps_the_image() {
+    let (dir, _) = temp("x.exr");
+    let render = |isa: &str| {
+        let out = dir.path().join(format!("{isa}.exr"));
+        let o = radiant(&[
+            "render",
+            "scenes/cornell-box.yaml",
+            "-o",
+            out.to_str().unwrap(),
+            "--spp",
+            "2",
+            "--width",
+            "48",
+            "--height",
+            "48",
+            "--backend",
+            "cpu",
+            "--max-isa",
+            isa,
+        ]);
+        (o, out)
+    };
+    let (o, widest) = render("avx512");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (o, baseline) = render("baseline");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read(&widest).unwrap(),
+        std::fs::read(&baseline).unwrap()
+    );
+
+    let (o, out) = render("sse9");
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert!(err.contains("baseline, avx2, avx512"), "{err}");
+    assert!(!out.exists());
+}

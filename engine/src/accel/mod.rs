@@ -14,9 +14,10 @@
 //!
 //! Both levels are 8-wide BVHs collapsed from obvhs' binary ones
 //! ([`hierarchy`]). Queries run the traversal compiled for the best
-//! instruction set the CPU has, chosen once per accelerator (`Level`: the
-//! baseline, AVX2, or the AVX2 code compiled with AVX-512 F and VL
-//! enabled, whose 32 vector registers spill less). Triangles use the watertight test of Woop et al. 2013.
+//! instruction set the CPU has, chosen once per accelerator
+//! ([`InstructionSet`]: the baseline, AVX2, or the AVX2 code compiled with
+//! AVX-512 F and VL enabled, whose 32 vector registers spill less), up to
+//! a limit a benchmark may set ([`limit_instruction_set`]). Triangles use the watertight test of Woop et al. 2013.
 //! Spawned rays start at origins offset by a conservative bound on the hit
 //! point's floating-point error ([`offset`]), which keeps self-intersection
 //! away at every scene scale without a fixed epsilon; instance transforms
@@ -62,6 +63,7 @@ use obvhs::aabb::Aabb;
 use std::borrow::Cow;
 use std::marker::PhantomData;
 use std::ops::Range;
+use std::sync::atomic::{AtomicU8, Ordering};
 use std::time::{Duration, Instant};
 use wide::{Avx2, Baseline, Isa, LeafCost, LeafVisitor, RayBoxes};
 
@@ -154,47 +156,75 @@ pub struct Accel {
     quality: BuildQuality,
     /// The instruction set queries are compiled for (the best the CPU
     /// has).
-    level: Level,
+    level: InstructionSet,
     /// Time the last build or update of the top level took.
     pub build_time: Duration,
 }
 
-/// The instruction sets a query is compiled for; [`Accel`] picks the best
-/// the CPU has once, when it is made.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Level {
-    /// The target's baseline: SSE2 on x86_64, portable code elsewhere.
+/// The instruction sets a query is compiled for. [`Accel`] picks the best
+/// the CPU has, up to the limit [`limit_instruction_set`] sets, once, when
+/// it is made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+pub enum InstructionSet {
+    /// The target's baseline: SSE4.2 on x86_64 (the build's
+    /// x86-64-v2), portable code elsewhere.
     Baseline,
-    /// AVX2: eight box lanes per instruction ([`Avx2`]).
-    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+    /// AVX2: eight box lanes per instruction.
     Avx2,
     /// The AVX2 traversal compiled with AVX-512 (F and VL) enabled: the
     /// same operations, but 32 vector registers instead of 16, so that
     /// fewer of the traversal's per-ray constants are spilled to the stack
     /// and reloaded at every node.
-    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     Avx512,
 }
 
-impl Level {
+/// The widest instruction set accelerators may use (as a `u8`), set by
+/// [`limit_instruction_set`]; no limit by default.
+static WIDEST: AtomicU8 = AtomicU8::new(InstructionSet::Avx512 as u8);
+
+/// Accelerators made from now on query with at most `widest`, even where
+/// the CPU has wider instructions: to measure on one machine what a CPU
+/// without them gets (`radiant render --max-isa avx2` stands in for an
+/// AVX2-only CPU on an AVX-512 one). Every instruction set gives the same
+/// hits; only the speed differs.
+pub fn limit_instruction_set(widest: InstructionSet) {
+    WIDEST.store(widest as u8, Ordering::Relaxed);
+}
+
+impl InstructionSet {
     /// The levels this CPU supports, worst first.
-    fn supported() -> Vec<Level> {
-        let mut levels = vec![Level::Baseline];
+    fn supported() -> Vec<InstructionSet> {
+        let mut levels = vec![InstructionSet::Baseline];
         #[cfg(target_arch = "x86_64")]
         if Avx2::detected() {
-            levels.push(Level::Avx2);
+            levels.push(InstructionSet::Avx2);
             if std::arch::is_x86_feature_detected!("avx512f")
                 && std::arch::is_x86_feature_detected!("avx512vl")
             {
-                levels.push(Level::Avx512);
+                levels.push(InstructionSet::Avx512);
             }
         }
         levels
     }
 
-    /// The best level this CPU supports.
-    fn detected() -> Level {
-        Level::supported().pop().unwrap_or(Level::Baseline)
+    /// The best level this CPU supports up to `widest`.
+    fn best_within(widest: InstructionSet) -> InstructionSet {
+        InstructionSet::supported()
+            .into_iter()
+            .rfind(|&level| level <= widest)
+            .unwrap_or(InstructionSet::Baseline)
+    }
+
+    /// The best level this CPU supports within the limit of
+    /// [`limit_instruction_set`].
+    fn detected() -> InstructionSet {
+        let widest = match WIDEST.load(Ordering::Relaxed) {
+            0 => InstructionSet::Baseline,
+            1 => InstructionSet::Avx2,
+            _ => InstructionSet::Avx512,
+        };
+        InstructionSet::best_within(widest)
     }
 }
 
@@ -215,12 +245,12 @@ macro_rules! dispatch {
                 accel.$with::<Avx2>($($arg),*)
             }
             result = match $accel.level {
-                Level::Baseline => $accel.$with::<Baseline>($($arg),*),
+                InstructionSet::Baseline => $accel.$with::<Baseline>($($arg),*),
                 // SAFETY: `level` is only ever a level the CPU supports
-                // (`Level::supported`).
-                Level::Avx2 => unsafe { avx2($accel, $($arg),*) },
+                // (`InstructionSet::supported`).
+                InstructionSet::Avx2 => unsafe { avx2($accel, $($arg),*) },
                 // SAFETY: as above.
-                Level::Avx512 => unsafe { avx512($accel, $($arg),*) },
+                InstructionSet::Avx512 => unsafe { avx512($accel, $($arg),*) },
             };
         }
         #[cfg(not(target_arch = "x86_64"))]
@@ -266,7 +296,7 @@ impl Accel {
             tlas_entries: HugeArray::default(),
             direct,
             quality,
-            level: Level::detected(),
+            level: InstructionSet::detected(),
             build_time: Duration::default(),
         };
         accel.build_top_level();
@@ -659,8 +689,8 @@ impl Accel {
     /// test one instruction set against another); `level` must be one the
     /// CPU supports.
     #[cfg(test)]
-    fn use_level(&mut self, level: Level) {
-        assert!(Level::supported().contains(&level));
+    fn use_level(&mut self, level: InstructionSet) {
+        assert!(InstructionSet::supported().contains(&level));
         self.level = level;
     }
 
@@ -924,6 +954,24 @@ pub(crate) mod tests {
             .min_by(|a, b| a.0.total_cmp(&b.0))
     }
 
+    /// A limit picks the best level the CPU has at or below it: the
+    /// limit itself where the CPU has it, never a wider one.
+    #[test]
+    fn the_instruction_set_limit_caps_the_level() {
+        let supported = InstructionSet::supported();
+        let best = *supported.last().expect("the baseline at least");
+        for widest in [
+            InstructionSet::Baseline,
+            InstructionSet::Avx2,
+            InstructionSet::Avx512,
+        ] {
+            let level = InstructionSet::best_within(widest);
+            assert!(level <= widest, "{widest:?} gave {level:?}");
+            assert!(supported.contains(&level));
+            assert_eq!(level, best.min(widest), "{widest:?}");
+        }
+    }
+
     #[test]
     fn bvh_agrees_with_brute_force_on_random_soups() {
         for (seed, count) in [(1u64, 1usize), (2, 2), (3, 50), (4, 2000)] {
@@ -941,7 +989,7 @@ pub(crate) mod tests {
             }
             let (accel, order) = Accel::build(&prims, BuildQuality::Medium);
             // Every instruction set the CPU has gives the same answers.
-            let others: Vec<Accel> = Level::supported()
+            let others: Vec<Accel> = InstructionSet::supported()
                 .into_iter()
                 .map(|level| {
                     let mut other = Accel::build(&prims, BuildQuality::Medium).0;

@@ -67,7 +67,7 @@ fn assert_coherent_hits_match(
     dirs: &[Vec3],
     times: Option<&[f32]>,
 ) {
-    for level in Level::supported() {
+    for level in InstructionSet::supported() {
         accel.use_level(level);
         let mut single = vec![Hit::MISS; origins.len()];
         let mut coherent = vec![Hit::MISS; origins.len()];

@@ -77,6 +77,11 @@ pub struct RenderArgs {
     /// boxes per 80-byte node).
     #[arg(long, value_enum, default_value_t = radiant::backend::BvhLayout::Binary)]
     gpu_bvh: radiant::backend::BvhLayout,
+    /// The widest instruction set the CPU traversal may use: `baseline`,
+    /// `avx2` or `avx512` (default: the best the CPU has). Stands in on one
+    /// machine for a CPU without the wider ones; the image is the same.
+    #[arg(long, value_enum, value_name = "ISA")]
+    max_isa: Option<radiant::accel::InstructionSet>,
     /// Render only the K-th of N disjoint sample partitions of one frame
     /// (`3/16`) into a partial EXR file for `radiant merge`.
     #[arg(long, value_parser = clap::value_parser!(radiant::farm::partition::Partition))]
@@ -222,6 +227,9 @@ pub fn run(registry: &Registry, args: &RenderArgs) -> miette::Result<()> {
     // The flags alone first, before the scene is read; then with its keys.
     passes::check(args, &radiant::settings::RenderSettings::default())?;
     whole_cpu::check_flags(args)?;
+    if let Some(widest) = args.max_isa {
+        radiant::accel::limit_instruction_set(widest);
+    }
     if let Some(p) = args.partition {
         return partition::run(registry, args, p);
     }

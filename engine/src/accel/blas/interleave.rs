@@ -231,7 +231,9 @@ impl Blas {
 #[cfg(test)]
 mod tests {
     use crate::accel::tests::{lcg, object, placements, swing, two_levels};
-    use crate::accel::{Accel, Blas, BuildQuality, Hit, Instance, Level, Place, Primitive};
+    use crate::accel::{
+        Accel, Blas, BuildQuality, Hit, Instance, InstructionSet, Place, Primitive,
+    };
     use glam::Vec3;
 
     /// `prims` with every triangle's vertices moved (a deforming mesh's
@@ -378,7 +380,7 @@ mod tests {
         };
         for (name, mut accel) in accels() {
             let mut hit_count = 0;
-            for level in Level::supported() {
+            for level in InstructionSet::supported() {
                 accel.use_level(level);
                 let mut hits = vec![untouched; origins.len()];
                 accel.intersect_slots(&slots, &origins, &dirs, None, &mut hits);
