@@ -34,6 +34,7 @@ Commands::
     python3 engine/benches/suite.py write           # (re)writes scenes/bench/*.yaml
     python3 engine/benches/suite.py references      # converged Mitsuba references
     python3 engine/benches/suite.py bench --radiant target/release/radiant [--runs 5]
+    python3 engine/benches/suite.py bench ... --isa avx2   # an AVX2-only host, stood in for
 
 ``references`` renders each scene with Mitsuba ``llvm_ad_rgb`` in two
 halves of ``--spp/2`` samples (default 4096 in all) into
@@ -621,8 +622,14 @@ def scene_variant(yaml, selection="", sampler=""):
 def cmd_bench(args):
     import numpy as np
     import drjit as dr
+    if args.isa != "native":
+        # Both renderers held to the instruction set: Mitsuba's kernels
+        # compiled for it, Radiant's traversal capped at it.
+        args.mitsuba_isa = args.isa
     mi = setup_mitsuba(args.threads, args.mitsuba_isa)
     extra = args.radiant_args.split() if args.radiant_args else []
+    if args.isa != "native":
+        extra += ["--max-isa", args.isa]
     rows = []
     for name, s in selected(args).items():
         ref_path, diff_path = ref_paths(name)
@@ -668,7 +675,8 @@ def cmd_bench(args):
           + (f"; Radiant with light_selection: {args.light_selection}" if args.light_selection else "")
           + (f"; Radiant's sampler: {args.sampler}" if args.sampler else "")
           + f"; Mitsuba's sampler: {args.mitsuba_sampler}"
-          + (f"; Mitsuba compiled for {args.mitsuba_isa}" if args.mitsuba_isa != "native" else ""))
+          + (f"; Mitsuba compiled for {args.mitsuba_isa}" if args.mitsuba_isa != "native" else "")
+          + (f"; Radiant's traversal capped at {args.isa}" if args.isa != "native" else ""))
     print("| scene | spp | Radiant s | Mitsuba s | speed | MSE Radiant | MSE Mitsuba | at equal error |")
     print("|---|---|---|---|---|---|---|---|")
     speeds, equal = [], []
@@ -774,7 +782,11 @@ def main():
     b.add_argument("--mitsuba-isa", default="native", choices=["native", "avx2"],
                    help="the instruction set Mitsuba's kernels are compiled for: the host's "
                         "(native), or an AVX2-only CPU's, eight lanes (avx2), to stand in for "
-                        "such a host")
+                        "such a host in Mitsuba's kernels only")
+    b.add_argument("--isa", default="native", choices=["native", "avx2"],
+                   help="an AVX2-only host stood in for on both sides: Mitsuba's kernels "
+                        "compiled for it (as --mitsuba-isa avx2) and Radiant's traversal "
+                        "capped at it (radiant render --max-isa avx2)")
     b.add_argument("--radiant-args", default="",
                    help="extra arguments for radiant render (one string)")
     pr = sub.add_parser("profile", help="perf profile of each scene on one thread")
