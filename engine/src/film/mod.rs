@@ -126,7 +126,9 @@ impl FilterTable {
         let cells = truncate4(x);
         // SAFETY: 0 ≤ x ≤ TABLE_RES in every lane, so each cell is at most
         // TABLE_RES, the factor's last index.
-        cells.map(|c| unsafe { *factor.get_unchecked(c as usize) }).into()
+        cells
+            .map(|c| unsafe { *factor.get_unchecked(c as usize) })
+            .into()
     }
 
     /// The fast path of a splat at `pos` whose footprint's columns start

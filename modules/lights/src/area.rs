@@ -10,8 +10,8 @@
 
 use crate::params::check_colour;
 use crate::rectangle::Rectangle;
-use crate::sphere::Cone;
-use radiant_core::glam::{Vec2, Vec3};
+use crate::sphere::{Cone, ConeSamples};
+use radiant_core::glam::{Vec2, Vec3, Vec4};
 use radiant_core::warp::{square_to_uniform_sphere, square_to_uniform_triangle};
 use radiant_core::{
     Color, Effects, EmitterEval, EmitterHit, EmitterShape, GpuModule, GpuParams, Light,
@@ -219,6 +219,39 @@ impl AreaLight {
         }
     }
 
+    /// Samples a light of one sphere, four reference points at a time
+    /// ([`ConeSamples`]); points not outside the sphere take
+    /// [`Self::sample_sphere`]'s area sampling one by one.
+    fn sample_one_sphere(
+        &self,
+        centre: Vec3,
+        r: f32,
+        refs: &[Vec3],
+        u: &[Vec2],
+        out: &mut [LightSample],
+    ) {
+        let probability = self.part_probability(0);
+        let n = refs.len().min(u.len()).min(out.len());
+        for start in (0..n).step_by(4) {
+            let end = (start + 4).min(n);
+            // The last group repeats its last point in the lanes past `n`.
+            let at = |k: usize| (start + k).min(end - 1);
+            let origins = [0, 1, 2, 3].map(|k| refs[at(k)].extend(0.0));
+            let lanes = ConeSamples::new(centre, r, origins, [0, 1, 2, 3].map(|k| u[at(k)]));
+            for (k, o) in out[start..end].iter_mut().enumerate() {
+                *o = if lanes.outside.test(k) {
+                    let lane = |v: &[Vec4; 3]| Vec3::new(v[0][k], v[1][k], v[2][k]);
+                    let pdf = probability * lanes.pdf[k];
+                    self.light_sample(lane(&lanes.p), lane(&lanes.n), pdf)
+                } else {
+                    let (i, ui) = (start + k, u[start + k]);
+                    let (p, n, pdf) = self.sample_sphere(centre, r, probability, refs[i], ui);
+                    self.light_sample(p, n, pdf)
+                };
+            }
+        }
+    }
+
     /// The sample at `p` (normal `n`) of density `pdf`; a failed one
     /// (radiance and density 0) where `pdf` is not positive and finite.
     #[inline(always)]
@@ -330,13 +363,7 @@ impl Light for AreaLight {
         // without picking or dispatch per sample.
         match self.parts.as_slice() {
             [Part::Rectangle(rect)] => self.sample_rectangle(rect, refs, u, out),
-            &[Part::Sphere(centre, r)] => {
-                let probability = self.part_probability(0);
-                for ((origin, u), o) in refs.iter().zip(u).zip(out.iter_mut()) {
-                    let (p, n, pdf) = self.sample_sphere(centre, r, probability, *origin, *u);
-                    *o = self.light_sample(p, n, pdf);
-                }
-            }
+            &[Part::Sphere(centre, r)] => self.sample_one_sphere(centre, r, refs, u, out),
             _ => {
                 for ((r, u), o) in refs.iter().zip(u).zip(out.iter_mut()) {
                     let (part, ux) = self.pick(u.x);
