@@ -164,21 +164,24 @@ impl PreparedBounds {
             return 0.0;
         }
         if self.isotropic_point {
-            return b.phi / d2;
+            return b.phi * (1.0 / d2);
         }
         // The angle the box subtends from p (all directions from inside).
         let radius2 = self.radius2;
         let dist2 = to_p.length_squared();
         let inside = p.cmpge(b.min).all() && p.cmple(b.max).all();
+        // One reciprocal of the distance serves the box's angle and the
+        // axis's cosine (the box's radius is its half diagonal).
+        let len = dist2.sqrt();
+        let inv_len = 1.0 / len;
         let (sin_b, cos_b) = if inside || dist2 <= radius2 {
             (0.0, -1.0)
         } else {
-            let sin2 = radius2 / dist2;
-            (sin2.sqrt(), (1.0 - sin2).max(0.0).sqrt())
+            let sin_b = self.half_diagonal * inv_len;
+            (sin_b, (1.0 - sin_b * sin_b).max(0.0).sqrt())
         };
-        let len = dist2.sqrt();
         let mut cos_w = if len > 0.0 {
-            to_p.dot(b.axis) / len
+            to_p.dot(b.axis) * inv_len
         } else {
             1.0
         };
@@ -194,7 +197,7 @@ impl PreparedBounds {
         if cos_p <= b.cos_theta_e {
             return 0.0;
         }
-        (b.phi * cos_p / d2).max(0.0)
+        (b.phi * cos_p * (1.0 / d2)).max(0.0)
     }
 }
 
@@ -278,12 +281,17 @@ impl BoundsLanes {
         });
         let radius2 = self.radius2;
         let small = inside | dist2.cmple(radius2);
-        let sin2 = radius2 / dist2;
-        let sin_b = Vec4::select(small, zero, sin2.sqrt());
-        let cos_b = Vec4::select(small, -one, (one - sin2).max(zero).sqrt());
         let len = dist2.sqrt();
+        let inv_len = one / len;
+        let sin_b = self.half_diagonal * inv_len;
+        let cos_b = Vec4::select(small, -one, (one - sin_b * sin_b).max(zero).sqrt());
+        let sin_b = Vec4::select(small, zero, sin_b);
         let [ax, ay, az] = self.axis;
-        let cos_w = Vec4::select(len.cmpgt(zero), (tx * ax + ty * ay + tz * az) / len, one);
+        let cos_w = Vec4::select(
+            len.cmpgt(zero),
+            (tx * ax + ty * ay + tz * az) * inv_len,
+            one,
+        );
         let cos_w = Vec4::select(self.two_sided, cos_w.abs(), cos_w);
         let sin_w = (one - cos_w * cos_w).max(zero).sqrt();
         let (sin_o, cos_o) = (self.sin_theta_o, self.cos_theta_o);
@@ -292,12 +300,13 @@ impl BoundsLanes {
         let cos_x = Vec4::select(within, one, cos_w * cos_o + sin_w * sin_o);
         let sin_x = Vec4::select(within, zero, sin_w * cos_o - cos_w * sin_o);
         let cos_p = Vec4::select(cos_x.cmpgt(cos_b), one, cos_x * cos_b + sin_x * sin_b);
+        let inv_d2 = one / d2;
         let cone = Vec4::select(
             cos_p.cmple(self.cos_theta_e),
             zero,
-            (self.phi * cos_p / d2).max(zero),
+            (self.phi * cos_p * inv_d2).max(zero),
         );
-        let value = Vec4::select(self.isotropic_point, self.phi / d2, cone);
+        let value = Vec4::select(self.isotropic_point, self.phi * inv_d2, cone);
         Vec4::select(d2.cmple(zero), zero, value)
     }
 }

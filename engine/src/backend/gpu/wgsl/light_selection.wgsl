@@ -82,21 +82,23 @@ fn sel_importance(r: u32, p: vec3f) -> f32 {
         return 0.0;
     }
     if cos_o <= -1.0 && all(lo == hi) {
-        return phi / d2;
+        return phi * (1.0 / d2);
     }
     let radius2 = dot(diagonal, diagonal) * 0.25;
     let inside = all(p >= lo) && all(p <= hi);
+    // One reciprocal of the distance for the box's angle and the axis's
+    // cosine (the box's radius is its half diagonal).
+    let len = sqrt(dist2);
+    let inv_len = 1.0 / len;
     var sin_b = 0.0;
     var cos_b = -1.0;
     if !(inside || dist2 <= radius2) {
-        let sin2 = radius2 / dist2;
-        sin_b = sqrt(sin2);
-        cos_b = sqrt(max(1.0 - sin2, 0.0));
+        sin_b = length(diagonal) * 0.5 * inv_len;
+        cos_b = sqrt(max(1.0 - sin_b * sin_b, 0.0));
     }
-    let len = sqrt(dist2);
     var cos_w = 1.0;
     if len > 0.0 {
-        cos_w = dot(to_p, axis) / len;
+        cos_w = dot(to_p, axis) * inv_len;
     }
     if param_u32(r + 12u) != 0u {
         cos_w = abs(cos_w);
@@ -109,7 +111,7 @@ fn sel_importance(r: u32, p: vec3f) -> f32 {
     if cos_p <= cos_e {
         return 0.0;
     }
-    return max(phi * cos_p / d2, 0.0);
+    return max(phi * cos_p * (1.0 / d2), 0.0);
 }
 
 // Σ importance at p over the bounded lights, in their order.
