@@ -900,7 +900,9 @@ impl Wavefront {
         }
         fit(&mut self.bsdf, n);
         fit(&mut self.nee_eval, n);
-        let mut ctx = ShadeContext::new(&scene.textures);
+        // A material's `sample` and `eval` look up its textures at the same
+        // coordinates: the second lookup reuses the first's values.
+        let mut ctx = ShadeContext::new(&scene.textures).with_stable_uv(&self.uv);
         let has_lights = !scene.lights.is_empty();
         for (shader, k) in material_ranges(&scene.shaders, &self.offsets) {
             let (a, b) = (k.start, k.end);

@@ -123,6 +123,13 @@ pub struct BsdfEval {
 pub struct ShadeContext<'a> {
     textures: &'a TextureTable,
     scratch: [Vec<Rgb>; 4],
+    /// What each scratch buffer holds, where it holds a texture's values at
+    /// texture coordinates inside `stable`: the texture and the
+    /// coordinates' address and length.
+    held: [Option<(TextureId, usize, usize)>; 4],
+    /// Texture coordinates that cannot change while the context lives
+    /// (see [`ShadeContext::with_stable_uv`]).
+    stable: &'a [Vec2],
     pool: Scratch,
 }
 
@@ -166,8 +173,33 @@ impl<'a> ShadeContext<'a> {
         Self {
             textures,
             scratch: Default::default(),
+            held: [None; 4],
+            stable: &[],
             pool: Scratch::default(),
         }
+    }
+
+    /// This context, told that `uv` holds the texture coordinates of the
+    /// batches it shades: a [`lookup`](Self::lookup) at a slice of them
+    /// that the same scratch buffer already answered for the same
+    /// texture returns those values again instead of evaluating the
+    /// texture anew, as when a shader's `sample` and `eval` look up the
+    /// same textures of one batch. `uv` is borrowed for the context's
+    /// lifetime, so it cannot change meanwhile; coordinates elsewhere (a
+    /// shader's own buffers) are always evaluated.
+    pub fn with_stable_uv(mut self, uv: &'a [Vec2]) -> Self {
+        self.stable = uv;
+        self.held = [None; 4];
+        self
+    }
+
+    /// The address and length of `uv` where it lies inside `stable`.
+    fn stable_key(&self, uv: &[Vec2]) -> Option<(usize, usize)> {
+        let range = self.stable.as_ptr_range();
+        let (start, end) = (range.start as usize, range.end as usize);
+        let at = uv.as_ptr() as usize;
+        let size = std::mem::size_of_val(uv);
+        (!uv.is_empty() && at >= start && at + size <= end).then_some((at, uv.len()))
     }
 
     /// Borrows a buffer of `len` default values (colours are `Vec3`);
@@ -195,13 +227,18 @@ impl<'a> ShadeContext<'a> {
     pub fn lookup<const N: usize>(&mut self, ids: [TextureId; N], uv: &[Vec2]) -> [&[Rgb]; N] {
         const { assert!(N <= 4, "at most four textures per lookup") };
         let textures = self.textures;
-        let mut bufs = self.scratch.iter_mut();
+        let key = self.stable_key(uv);
+        let mut bufs = self.scratch.iter_mut().zip(&mut self.held);
         ids.map(|id| {
-            let buf = bufs.next().expect("N <= 4");
-            if buf.len() < uv.len() {
-                buf.resize(uv.len(), Rgb::ZERO);
+            let (buf, held) = bufs.next().expect("N <= 4");
+            let now = key.map(|(at, len)| (id, at, len));
+            if now.is_none() || *held != now {
+                if buf.len() < uv.len() {
+                    buf.resize(uv.len(), Rgb::ZERO);
+                }
+                textures.eval(id, uv, buf);
+                *held = now;
             }
-            textures.eval(id, uv, buf);
             &buf[..uv.len()]
         })
     }
@@ -323,4 +360,69 @@ pub fn estimate_albedo<S: Shader + ?Sized>(
     }
     ctx.recycle(u);
     ctx.recycle(samples);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Texture;
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// u + v in every channel, counting the points it evaluates.
+    struct Counting(Arc<AtomicUsize>);
+
+    impl Texture for Counting {
+        fn eval(&self, uv: &[Vec2], out: &mut [Rgb]) {
+            self.0.fetch_add(uv.len(), Ordering::Relaxed);
+            for (o, p) in out.iter_mut().zip(uv) {
+                *o = Rgb::splat(p.x + p.y);
+            }
+        }
+
+        fn mean(&self) -> Rgb {
+            Rgb::ONE
+        }
+    }
+
+    /// A second lookup of the same texture at the same stable coordinates
+    /// is answered from the first; other textures, other slices and
+    /// coordinates outside the stable ones are evaluated anew.
+    #[test]
+    fn stable_coordinates_are_looked_up_once() {
+        let counted = Arc::new(AtomicUsize::new(0));
+        let mut textures = TextureTable::default();
+        let a = textures.add(Box::new(Counting(counted.clone())));
+        let b = textures.add(Box::new(Counting(counted.clone())));
+        let uv: Vec<Vec2> = (0..8).map(|i| Vec2::new(i as f32, 0.5)).collect();
+        let evaluated = || counted.load(Ordering::Relaxed);
+        let mut ctx = ShadeContext::new(&textures).with_stable_uv(&uv);
+        let first = ctx.lookup([a], &uv[2..6])[0].to_vec();
+        assert_eq!(evaluated(), 4);
+        let again = ctx.lookup([a], &uv[2..6])[0].to_vec();
+        assert_eq!(
+            (evaluated(), &again),
+            (4, &first),
+            "answered from the buffer"
+        );
+        ctx.lookup([b], &uv[2..6]);
+        assert_eq!(evaluated(), 8, "another texture in the same buffer");
+        let [x, y] = ctx.lookup([b, a], &uv[2..6]);
+        assert_eq!((x.to_vec(), y.to_vec()), (again.clone(), again.clone()));
+        assert_eq!(evaluated(), 12, "b from its buffer, a in another one");
+        ctx.lookup([a], &uv[2..5]);
+        assert_eq!(evaluated(), 15, "another slice");
+        // Coordinates of a shader's own, which it may change in place.
+        let mut own = uv[2..6].to_vec();
+        ctx.lookup([a], &own);
+        own[0].x += 1.0;
+        let changed = ctx.lookup([a], &own)[0].to_vec();
+        assert_eq!(evaluated(), 23);
+        assert_eq!(changed[0], first[0] + Rgb::ONE);
+        // Without stable coordinates every lookup evaluates.
+        let mut plain = ShadeContext::new(&textures);
+        plain.lookup([a], &uv);
+        plain.lookup([a], &uv);
+        assert_eq!(evaluated(), 39);
+    }
 }
