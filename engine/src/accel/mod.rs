@@ -17,7 +17,8 @@
 //! instruction set the CPU has, chosen once per accelerator
 //! ([`InstructionSet`]: the baseline, AVX2, or the AVX2 code compiled with
 //! AVX-512 F and VL enabled, whose 32 vector registers spill less), up to
-//! a limit a benchmark may set ([`limit_instruction_set`]). Triangles use the watertight test of Woop et al. 2013.
+//! a limit a benchmark may set ([`limit_instruction_set`]). Triangles use
+//! the watertight test of Woop et al. 2013.
 //! Spawned rays start at origins offset by a conservative bound on the hit
 //! point's floating-point error ([`offset`]), which keeps self-intersection
 //! away at every scene scale without a fixed epsilon; instance transforms
@@ -155,7 +156,7 @@ pub struct Accel {
     direct: bool,
     quality: BuildQuality,
     /// The instruction set queries are compiled for (the best the CPU
-    /// has).
+    /// has within [`limit_instruction_set`]'s limit).
     level: InstructionSet,
     /// Time the last build or update of the top level took.
     pub build_time: Duration,
