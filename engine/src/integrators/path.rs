@@ -402,7 +402,9 @@ impl Wavefront {
     /// `self.film`: lens samples, rays, shutter times, path state.
     fn start_paths(&mut self, scene: &RenderScene, sampler: &dyn Sampler, n: usize) {
         fit(&mut self.u2, n);
-        sampler.fill_2d(&self.ids, 2, &mut self.u2);
+        if scene.camera.uses_lens_samples() {
+            sampler.fill_2d(&self.ids, 2, &mut self.u2);
+        }
         fit(&mut self.origin, n);
         fit(&mut self.dir, n);
         fit(&mut self.u1, n);
@@ -801,7 +803,11 @@ impl Wavefront {
     /// per light.
     fn sample_lights(&mut self, scene: &RenderScene, sampler: &dyn Sampler, n: usize, base: u32) {
         fit(&mut self.u2, n);
-        sampler.fill_2d(&self.ids_k, base + 1, &mut self.u2);
+        // Points on lights, where a light reads them: a point or spot
+        // light has nothing to choose.
+        if scene.lights.lights().iter().any(|l| l.uses_point_samples()) {
+            sampler.fill_2d(&self.ids_k, base + 1, &mut self.u2);
+        }
         fit(&mut self.light, n);
         fit(&mut self.light_prob, n);
         fit(&mut self.light_sample, n);
@@ -893,8 +899,13 @@ impl Wavefront {
         fit(&mut self.u3, n);
         fit(&mut self.u1, n);
         fit(&mut self.u2, n);
-        sampler.fill_1d(&self.ids_k, base + 3, &mut self.u1);
         sampler.fill_2d(&self.ids_k, base + 4, &mut self.u2);
+        // Lobe choices only for the materials that have lobes to choose.
+        for (shader, k) in material_ranges(&scene.shaders, &self.offsets) {
+            if shader.uses_lobe_samples() {
+                sampler.fill_1d(&self.ids_k[k.clone()], base + 3, &mut self.u1[k]);
+            }
+        }
         for ((u3, &u1), u2) in self.u3.iter_mut().zip(&self.u1).zip(&self.u2) {
             *u3 = Vec3::new(u1, u2.x, u2.y);
         }

@@ -112,6 +112,10 @@ impl Camera for Orthographic {
         Some(self)
     }
 
+    fn uses_lens_samples(&self) -> bool {
+        false
+    }
+
     fn generate(&self, film: &[Vec2], _lens: &[Vec2], out: CameraRays<'_>) {
         let dir = self.direction();
         for (i, p) in film.iter().enumerate() {

@@ -46,6 +46,10 @@ impl Perspective {
 }
 
 impl Camera for Perspective {
+    fn uses_lens_samples(&self) -> bool {
+        false
+    }
+
     fn generate(&self, film: &[Vec2], _lens: &[Vec2], out: CameraRays<'_>) {
         central_rays(&self.to_render, film, out, |p| {
             self.pinhole.plane_point(p).extend(1.0)

@@ -78,6 +78,10 @@ impl Spherical {
 }
 
 impl Camera for Spherical {
+    fn uses_lens_samples(&self) -> bool {
+        false
+    }
+
     fn generate(&self, film: &[Vec2], _lens: &[Vec2], out: CameraRays<'_>) {
         central_rays(&self.to_render, film, out, |p| self.direction(p));
     }

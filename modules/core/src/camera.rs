@@ -86,6 +86,14 @@ pub trait Camera: Send + Sync {
     /// slices are not cleared between batches.
     fn generate(&self, film: &[Vec2], lens: &[Vec2], out: CameraRays<'_>);
 
+    /// Whether [`generate`](Self::generate) reads its lens samples. A
+    /// camera with one centre of projection (a pinhole) returns `false`,
+    /// and the integrator then draws no lens samples for it (their
+    /// contents are unspecified). The default, `true`, is always correct.
+    fn uses_lens_samples(&self) -> bool {
+        true
+    }
+
     /// The camera's importance side, for light paths that reach the lens
     /// (bidirectional path tracing); `None` where the type has none, and
     /// integrators that need it refuse the scene, naming the camera's type.

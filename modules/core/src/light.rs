@@ -76,6 +76,14 @@ pub trait Light: Send + Sync {
     /// `n · (refs[i] − p) > 0`.
     fn sample(&self, refs: &[Vec3], u: &[Vec2], out: &mut [LightSample]);
 
+    /// Whether [`sample`](Self::sample) reads its 2D samples `u`. A light at
+    /// one point or from one direction returns `false`, and the integrator
+    /// then draws no samples for it (their contents are unspecified). The
+    /// default, `true`, is always correct.
+    fn uses_point_samples(&self) -> bool {
+        true
+    }
+
     /// Evaluates emission for rays that hit this light's surface. Lights
     /// without surfaces are never hit, so the default writes nothing.
     fn eval_hits(&self, hits: &[EmitterHit], out: &mut [EmitterEval]) {

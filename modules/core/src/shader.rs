@@ -285,6 +285,14 @@ pub trait Shader: Send + Sync {
         out: &mut [BsdfSample],
     );
 
+    /// Whether [`sample`](Self::sample) reads the lobe choice `u[i].x`. A
+    /// shader with one lobe returns `false`, and the integrator then draws
+    /// no lobe samples for it (their contents are unspecified). The
+    /// default, `true`, is always correct.
+    fn uses_lobe_samples(&self) -> bool {
+        true
+    }
+
     /// Evaluates the BSDF for each surface point and incident direction
     /// `wi[i]` (local frame).
     fn eval(

@@ -71,6 +71,10 @@ impl Light for DirectionalLight {
         true
     }
 
+    fn uses_point_samples(&self) -> bool {
+        false
+    }
+
     fn sample(&self, refs: &[Vec3], _u: &[Vec2], out: &mut [LightSample]) {
         let back = self.back();
         sample_delta(refs, out, |r| (r + back, self.irradiance));

@@ -67,6 +67,10 @@ impl Light for PointLight {
         true
     }
 
+    fn uses_point_samples(&self) -> bool {
+        false
+    }
+
     fn sample(&self, refs: &[Vec3], _u: &[Vec2], out: &mut [LightSample]) {
         sample_delta(refs, out, |r| {
             let dist2 = (self.position - r).length_squared();

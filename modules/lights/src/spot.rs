@@ -142,6 +142,10 @@ impl Light for SpotLight {
         true
     }
 
+    fn uses_point_samples(&self) -> bool {
+        false
+    }
+
     fn sample(&self, refs: &[Vec3], _u: &[Vec2], out: &mut [LightSample]) {
         sample_delta(refs, out, |r| {
             let d = r - self.position;

@@ -91,6 +91,10 @@ struct Conductor {
 }
 
 impl Shader for Conductor {
+    fn uses_lobe_samples(&self) -> bool {
+        false
+    }
+
     fn sample(
         &self,
         ctx: &mut ShadeContext<'_>,

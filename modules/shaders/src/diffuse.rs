@@ -46,6 +46,10 @@ impl Diffuse {
 }
 
 impl Shader for Diffuse {
+    fn uses_lobe_samples(&self) -> bool {
+        false
+    }
+
     fn sample(
         &self,
         ctx: &mut ShadeContext<'_>,

@@ -274,6 +274,10 @@ impl<N: NormalSource> Shader for Perturbed<N> {
         ctx.recycle(alpha2);
     }
 
+    fn uses_lobe_samples(&self) -> bool {
+        self.nested.uses_lobe_samples()
+    }
+
     fn effects(&self) -> Effects {
         self.effects
     }

@@ -98,6 +98,10 @@ fn oren_nayar(rho: Rgb, alpha: f32, wo: Vec3, wi: Vec3) -> Rgb {
 }
 
 impl Shader for RoughDiffuse {
+    fn uses_lobe_samples(&self) -> bool {
+        false
+    }
+
     fn sample(
         &self,
         ctx: &mut ShadeContext<'_>,
