@@ -16,7 +16,8 @@
 //! ([`LightTable::select_many`], [`LightTable::pmf_many`]): the same
 //! values, with each light's importance evaluated at four points per
 //! instruction, so that the points' long chains of square roots and
-//! divisions overlap.
+//! divisions overlap, and the choice among the lights made for four
+//! points at a time too.
 
 use super::light_tree::LightTree;
 use crate::settings::LightSelection;
@@ -211,14 +212,28 @@ impl LightTable {
     /// into `prob`, bit for bit as one call per point.
     pub fn select_many(&self, points: &[Vec3], u: &[f32], light: &mut [u32], prob: &mut [f32]) {
         let n = points.len().min(u.len()).min(light.len()).min(prob.len());
-        self.per_point(&points[..n], |k, weights| {
-            let (l, p) = match weights {
-                Some(w) if u[k] >= self.p_unbounded => {
-                    self.pick_bounded(w, positive_sum(&w[..self.bounded.len()]), u[k])
-                }
-                _ => self.select_at(points[k], u[k]),
-            };
-            (light[k], prob[k]) = (l as u32, p);
+        let visit = |k: usize| {
+            let (l, p) = self.select_at(points[k], u[k]);
+            (l as u32, p)
+        };
+        if !self.is_flat_spatial() {
+            for k in 0..n {
+                (light[k], prob[k]) = visit(k);
+            }
+            return;
+        }
+        self.per_quad(&points[..n], |k, weights| {
+            let m = (n - k).min(4);
+            let uq = Vec4::from_array(std::array::from_fn(|j| u[k + j.min(m - 1)]));
+            let (l, p) = self.pick_bounded_lanes(weights, uq);
+            let p = p.to_array();
+            for j in 0..m {
+                (light[k + j], prob[k + j]) = if u[k + j] >= self.p_unbounded {
+                    (self.bounded[l[j] as usize].0, p[j])
+                } else {
+                    visit(k + j)
+                };
+            }
         });
     }
 
@@ -226,15 +241,25 @@ impl LightTable {
     /// `light`, into `pmf`, bit for bit as one call per point.
     pub fn pmf_many(&self, points: &[Vec3], light: &[u32], pmf: &mut [f32]) {
         let n = points.len().min(light.len()).min(pmf.len());
-        self.per_point(&points[..n], |k, weights| {
-            let i = light[k] as usize;
-            let slot = self.slot_of[i] as usize;
-            pmf[k] = match weights {
-                Some(w) if slot < self.bounded.len() => {
-                    self.pmf_bounded(w, positive_sum(&w[..self.bounded.len()]), slot)
-                }
-                _ => self.pmf_at(points[k], i),
-            };
+        if !self.is_flat_spatial() {
+            for k in 0..n {
+                pmf[k] = self.pmf_at(points[k], light[k] as usize);
+            }
+            return;
+        }
+        let nb = self.bounded.len();
+        self.per_quad(&points[..n], |k, weights| {
+            let total = positive_sum_lanes(&weights[..nb]).to_array();
+            for j in 0..(n - k).min(4) {
+                let i = light[k + j] as usize;
+                let slot = self.slot_of[i] as usize;
+                pmf[k + j] = if slot < nb {
+                    let w: [f32; FLAT_LIMIT] = std::array::from_fn(|l| weights[l][j]);
+                    self.pmf_bounded(&w, total[j], slot)
+                } else {
+                    self.pmf_at(points[k + j], i)
+                };
+            }
         });
     }
 
@@ -249,38 +274,79 @@ impl LightTable {
         }
     }
 
-    /// Calls `visit(k, weights)` for each of `points` in order, with the
-    /// bounded lights' importances at `points[k]` where spatial selection
-    /// weighs at most [`FLAT_LIMIT`] lights one by one, else `None`. The
-    /// importances are evaluated one light at four points at a time, a
-    /// block of points per pass: four independent evaluations instead of
-    /// one long chain of square roots and divisions per point.
+    /// Whether spatial selection weighs each bounded light one by one
+    /// (at most [`FLAT_LIMIT`] of them, and at least one).
     #[inline]
-    fn per_point(&self, points: &[Vec3], mut visit: impl FnMut(usize, Option<&[f32; FLAT_LIMIT]>)) {
-        const BLOCK: usize = 64;
-        if !self.is_spatial() || self.each.is_empty() {
-            for k in 0..points.len() {
-                visit(k, None);
+    fn is_flat_spatial(&self) -> bool {
+        self.is_spatial() && !self.each.is_empty()
+    }
+
+    /// Calls `visit(k, weights)` for the points from `k` on, four at a
+    /// time (fewer at the end: the last point fills the other lanes),
+    /// with `weights[slot]` the bounded light `slot`'s importances at
+    /// those points. The importances are evaluated one light at four
+    /// points at a time, a block of points per pass, from the points'
+    /// coordinates gathered into lanes once per block: four independent
+    /// evaluations instead of one long chain of square roots and
+    /// divisions per point. Only for flat spatial selection
+    /// ([`Self::is_flat_spatial`]).
+    #[inline]
+    fn per_quad(&self, points: &[Vec3], mut visit: impl FnMut(usize, &[Vec4; FLAT_LIMIT])) {
+        const QUADS: usize = 16;
+        let mut coords = [[Vec4::ZERO; 3]; QUADS];
+        let mut weights = [[Vec4::ZERO; FLAT_LIMIT]; QUADS];
+        for (b, block) in points.chunks(4 * QUADS).enumerate() {
+            for (quad, c) in block.chunks(4).zip(&mut coords) {
+                *c = std::array::from_fn(|axis| {
+                    Vec4::from_array(std::array::from_fn(|j| quad[j.min(quad.len() - 1)][axis]))
+                });
             }
-            return;
-        }
-        let mut weights = [[0.0f32; FLAT_LIMIT]; BLOCK];
-        for (b, block) in points.chunks(BLOCK).enumerate() {
+            let quads = block.len().div_ceil(4);
             for (slot, lanes) in self.each.iter().enumerate() {
-                for (q, quad) in block.chunks(4).enumerate() {
-                    let coord = |k: usize| {
-                        Vec4::from_array([0, 1, 2, 3].map(|j| quad[j.min(quad.len() - 1)][k]))
-                    };
-                    let w = lanes.importance_at([coord(0), coord(1), coord(2)]);
-                    for (j, w) in w.to_array().into_iter().enumerate().take(quad.len()) {
-                        weights[4 * q + j][slot] = w;
-                    }
+                for (w, c) in weights[..quads].iter_mut().zip(&coords) {
+                    w[slot] = lanes.importance_at(*c);
                 }
             }
-            for (j, w) in weights[..block.len()].iter().enumerate() {
-                visit(b * BLOCK + j, Some(w));
+            for (q, w) in weights[..quads].iter().enumerate() {
+                visit(b * 4 * QUADS + 4 * q, w);
             }
         }
+    }
+
+    /// [`pick_bounded`](Self::pick_bounded) in four lanes: the slots
+    /// (in `bounded`) that the samples `u` (each at least the unbounded
+    /// lights' share) pick in proportion to the bounded lights'
+    /// importances `weights[slot]`, and their probabilities, bit for bit
+    /// lane by lane. Slot numbers and counts are held as floats (exact
+    /// below 2²⁴), so that every step is a vector operation.
+    #[inline]
+    fn pick_bounded_lanes(&self, weights: &[Vec4; FLAT_LIMIT], u: Vec4) -> ([u32; 4], Vec4) {
+        let weights = &weights[..self.bounded.len()];
+        let total = positive_sum_lanes(weights);
+        let share = 1.0 - self.p_unbounded;
+        let target = (u - Vec4::splat(self.p_unbounded)) / Vec4::splat(share) * total;
+        // `pick_by_weight`: how many running sums are at most the target,
+        // or where that is all of them, the last light with a weight.
+        let (mut sum, mut below, mut last) = (Vec4::ZERO, Vec4::ZERO, Vec4::ZERO);
+        for (slot, &w) in weights.iter().enumerate() {
+            let positive = w.cmpgt(Vec4::ZERO);
+            sum += Vec4::select(positive, w, Vec4::ZERO);
+            below += Vec4::select(sum.cmple(target), Vec4::ONE, Vec4::ZERO);
+            last = Vec4::select(positive, Vec4::splat(slot as f32), last);
+        }
+        let count = Vec4::splat(weights.len() as f32);
+        let none = total.cmple(Vec4::ZERO);
+        let slot = Vec4::select(
+            none,
+            Vec4::ZERO,
+            Vec4::select(below.cmplt(count), below, last),
+        );
+        let mut chosen = Vec4::ZERO;
+        for (l, &w) in weights.iter().enumerate() {
+            chosen = Vec4::select(slot.cmpeq(Vec4::splat(l as f32)), w, chosen);
+        }
+        let p = Vec4::select(none, Vec4::ZERO, Vec4::splat(share) * chosen / total);
+        (slot.to_array().map(|s| s as u32), p)
     }
 
     /// The bounded light that `u` (at least the unbounded lights' share)
@@ -430,6 +496,17 @@ fn positive_sum(weights: &[f32]) -> f32 {
         if w > 0.0 {
             total += w;
         }
+    }
+    total
+}
+
+/// [`positive_sum`] in four lanes: adding zero where a weight is not
+/// positive leaves a sum that starts at +0 as it is, bit for bit.
+#[inline]
+fn positive_sum_lanes(weights: &[Vec4]) -> Vec4 {
+    let mut total = Vec4::ZERO;
+    for &w in weights {
+        total += Vec4::select(w.cmpgt(Vec4::ZERO), w, Vec4::ZERO);
     }
     total
 }
