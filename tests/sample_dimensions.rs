@@ -4,9 +4,10 @@
 //! (`Light::uses_point_samples`) and a shader with one lobe
 //! (`Shader::uses_lobe_samples`). The path integrator draws no such samples
 //! for them, so a module that said so and read them anyway would see
-//! whatever the buffer last held. Every built-in type is checked, and the
-//! check is shown to fail on modules that do read them (a thin lens, an
-//! area light, plastic's lobe choice).
+//! whatever the buffer last held. Every built-in module that declares
+//! samples unused is checked, and the check is shown to fail on modules
+//! that do read them (a thin lens, area and environment lights, the
+//! lobe choices of plastic, dielectrics, principled and blend).
 
 // `unwrap` in this test code is the assertion: the inputs are the test's
 // own, so a failure is a bug, and the panic reports it with the error.
