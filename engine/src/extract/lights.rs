@@ -35,6 +35,8 @@ pub struct LightTable {
     cdf: Vec<f32>,
     pmf: Vec<f32>,
     delta: Vec<bool>,
+    /// Whether any light reads the 2D samples of its `sample`.
+    point_samples: bool,
     environment: Vec<usize>,
     selection: LightSelection,
     /// Spatial selection: the lights with bounds, and theirs.
@@ -107,6 +109,7 @@ impl LightTable {
             *last = 1.0;
         }
         let delta = lights.iter().map(|l| l.is_delta()).collect();
+        let point_samples = lights.iter().any(|l| l.uses_point_samples());
         let environment = (0..lights.len())
             .filter(|&i| lights[i].effects().contains(Effects::ENVIRONMENT))
             .collect();
@@ -146,6 +149,7 @@ impl LightTable {
             cdf,
             pmf,
             delta,
+            point_samples,
             environment,
             selection,
             bounded,
@@ -254,8 +258,7 @@ impl LightTable {
                 let i = light[k + j] as usize;
                 let slot = self.slot_of[i] as usize;
                 pmf[k + j] = if slot < nb {
-                    let w: [f32; FLAT_LIMIT] = std::array::from_fn(|l| weights[l][j]);
-                    self.pmf_bounded(&w, total[j], slot)
+                    self.pmf_bounded(weights[slot][j], total[j])
                 } else {
                     self.pmf_at(points[k + j], i)
                 };
@@ -264,11 +267,12 @@ impl LightTable {
     }
 
     /// The probability that [`pick_bounded`](Self::pick_bounded) picks
-    /// the bounded light in `slot` given the same `weights` and `total`.
+    /// a bounded light of importance `weight` where the positive
+    /// importances sum to `total`.
     #[inline]
-    fn pmf_bounded(&self, weights: &[f32], total: f32, slot: usize) -> f32 {
+    fn pmf_bounded(&self, weight: f32, total: f32) -> f32 {
         if total > 0.0 {
-            (1.0 - self.p_unbounded) * weights[slot] / total
+            (1.0 - self.p_unbounded) * weight / total
         } else {
             0.0
         }
@@ -379,7 +383,7 @@ impl LightTable {
                 return share * tree.pmf(p, slot);
             }
             let (weights, total) = self.importances(p);
-            return self.pmf_bounded(&weights, total, slot);
+            return self.pmf_bounded(weights[slot], total);
         }
         if self.unbounded.contains(&(i as u32)) {
             self.p_unbounded / self.unbounded.len() as f32
@@ -453,6 +457,14 @@ impl LightTable {
     #[inline]
     pub fn is_delta(&self, i: usize) -> bool {
         self.delta[i]
+    }
+
+    /// Whether any light's `sample` reads its 2D samples
+    /// ([`Light::uses_point_samples`]): where none does, they need not be
+    /// drawn.
+    #[inline]
+    pub fn uses_point_samples(&self) -> bool {
+        self.point_samples
     }
 
     /// Indices of the lights that rays leaving the scene can reach (those

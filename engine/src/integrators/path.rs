@@ -805,7 +805,7 @@ impl Wavefront {
         fit(&mut self.u2, n);
         // Points on lights, where a light reads them: a point or spot
         // light has nothing to choose.
-        if scene.lights.lights().iter().any(|l| l.uses_point_samples()) {
+        if scene.lights.uses_point_samples() {
             sampler.fill_2d(&self.ids_k, base + 1, &mut self.u2);
         }
         fit(&mut self.light, n);
