@@ -17,6 +17,7 @@
 pub mod adaptive;
 pub mod bdpt;
 pub mod budget;
+mod buffer;
 mod medium;
 pub mod mlt;
 pub mod module;

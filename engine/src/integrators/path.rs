@@ -18,6 +18,7 @@
 //! the live paths' slots (structure of arrays); modules are called once per
 //! group of paths that share a material or a light.
 
+use super::buffer::Buffer;
 use super::medium::{self, MEDIUM_DIMS, MediumState};
 use super::sort::sort_by_key;
 use super::surface::{
@@ -70,25 +71,25 @@ pub struct Batch {
 #[derive(Default)]
 pub struct Wavefront {
     // Path state, indexed by slot.
-    ids: Vec<SampleId>,
+    ids: Buffer<SampleId>,
     /// Raster positions of the camera samples.
-    film: Vec<Vec2>,
+    film: Buffer<Vec2>,
     /// Filter weights f/pdf of the samples (filter importance sampling).
-    filter_weight: Vec<f32>,
-    origin: Vec<Vec3>,
-    dir: Vec<Vec3>,
+    filter_weight: Buffer<f32>,
+    origin: Buffer<Vec3>,
+    dir: Buffer<Vec3>,
     /// Shutter time τ in [0, 1) of each path (only under motion blur).
-    time: Vec<f32>,
-    beta: Vec<Rgb>,
+    time: Buffer<f32>,
+    beta: Buffer<Rgb>,
     /// Product of η² over the refractions so far (see [`BsdfSample::eta`]).
-    eta_scale: Vec<f32>,
-    radiance: Vec<Rgb>,
-    prev_pdf: Vec<f32>,
-    hit: Vec<Hit>,
-    its: Vec<Interaction>,
+    eta_scale: Buffer<f32>,
+    radiance: Buffer<Rgb>,
+    prev_pdf: Buffer<f32>,
+    hit: Buffer<Hit>,
+    its: Buffer<Interaction>,
     /// Surface derivatives of the hits (only where a shader needs
     /// [`Effects::TANGENT_FRAMES`]).
-    derivs: Vec<Derivatives>,
+    derivs: Buffer<Derivatives>,
     // Live slots, and sort scratch.
     live: Vec<u32>,
     next_live: Vec<u32>,
@@ -96,62 +97,62 @@ pub struct Wavefront {
     cursor: Vec<u32>,
     offsets: Vec<u32>,
     // Per live path in material order (index k).
-    ids_k: Vec<SampleId>,
-    wo: Vec<Vec3>,
-    uv: Vec<Vec2>,
+    ids_k: Buffer<SampleId>,
+    wo: Buffer<Vec3>,
+    uv: Buffer<Vec2>,
     /// ∂p/∂u and ∂p/∂v in the local frames (only under
     /// [`Effects::TANGENT_FRAMES`]).
-    dp_du: Vec<Vec3>,
-    dp_dv: Vec<Vec3>,
-    u1: Vec<f32>,
-    u2: Vec<Vec2>,
-    u3: Vec<Vec3>,
-    bsdf: Vec<BsdfSample>,
-    nee_wi: Vec<Vec3>,
+    dp_du: Buffer<Vec3>,
+    dp_dv: Buffer<Vec3>,
+    u1: Buffer<f32>,
+    u2: Buffer<Vec2>,
+    u3: Buffer<Vec3>,
+    bsdf: Buffer<BsdfSample>,
+    nee_wi: Buffer<Vec3>,
     /// `nee_wi` in world space.
-    nee_wi_world: Vec<Vec3>,
-    nee_eval: Vec<BsdfEval>,
-    light: Vec<u32>,
-    light_prob: Vec<f32>,
-    light_sample: Vec<LightSample>,
+    nee_wi_world: Buffer<Vec3>,
+    nee_eval: Buffer<BsdfEval>,
+    light: Buffer<u32>,
+    light_prob: Buffer<f32>,
+    light_sample: Buffer<LightSample>,
     /// Points handed to the light table: the live paths' shading points
     /// (in `live`'s order) when choosing lights, the emitter hits' ray
     /// origins when weighing those hits.
-    points: Vec<Vec3>,
+    points: Buffer<Vec3>,
     // Grouping by light.
     by_light: Vec<u32>,
     light_offsets: Vec<u32>,
-    refs: Vec<Vec3>,
-    light_u: Vec<Vec2>,
-    light_out: Vec<LightSample>,
+    refs: Buffer<Vec3>,
+    light_u: Buffer<Vec2>,
+    light_out: Buffer<LightSample>,
     // Emitter hits.
     em_slots: Vec<u32>,
-    em_hits: Vec<EmitterHit>,
-    em_evals: Vec<EmitterEval>,
+    em_hits: Buffer<EmitterHit>,
+    em_evals: Buffer<EmitterEval>,
     /// The light of each emitter hit, and its selection probability from
     /// the hit's ray origin.
-    em_light: Vec<u32>,
-    em_pmf: Vec<f32>,
+    em_light: Buffer<u32>,
+    em_pmf: Buffer<f32>,
     // Rays that left the scene (environment lights).
-    esc_slots: Vec<u32>,
-    esc_dirs: Vec<Vec3>,
-    esc_evals: Vec<EmitterEval>,
+    esc_slots: Buffer<u32>,
+    esc_dirs: Buffer<Vec3>,
+    esc_evals: Buffer<EmitterEval>,
     // Shadow rays.
-    shadow_slot: Vec<u32>,
-    shadow_origin: Vec<Vec3>,
-    shadow_dir: Vec<Vec3>,
-    shadow_value: Vec<Rgb>,
+    shadow_slot: Buffer<u32>,
+    shadow_origin: Buffer<Vec3>,
+    shadow_dir: Buffer<Vec3>,
+    shadow_value: Buffer<Rgb>,
     /// Shutter time of each shadow ray (only under motion blur).
     shadow_time: Vec<f32>,
     /// Per shadow ray: whether something blocks it.
-    shadow_blocked: Vec<bool>,
+    shadow_blocked: Buffer<bool>,
     // Output variables (only while a batch collects them).
     /// Whether this batch records its camera rays' first hits.
     collect_aovs: bool,
     /// What each camera path's first segment found, by slot.
-    first_hits: Vec<FirstHit>,
+    first_hits: Buffer<FirstHit>,
     /// The first hits' albedos, per live path in material order.
-    albedo_k: Vec<Rgb>,
+    albedo_k: Buffer<Rgb>,
     /// Medium state (only in frames with media; see `integrators/medium.rs`).
     media: MediumState,
     /// Rays traced so far (camera, continuation and shadow rays).
@@ -166,18 +167,6 @@ fn move_camera_rays(motion: &Motion, time: &[f32], origin: &mut [Vec3], dir: &mu
         *o = m.transform_point3(o.as_dvec3()).as_vec3();
         *d = m.transform_vector3(d.as_dvec3()).as_vec3().normalize();
     }
-}
-
-/// Gives `v` length `n` for a stage that writes every element (old values
-/// stay until overwritten; only growth initialises).
-fn fit<T: Clone + Default>(v: &mut Vec<T>, n: usize) {
-    v.resize(n, T::default());
-}
-
-/// Gives `v` length `n`, every element `T::default()`.
-fn zeroed<T: Clone + Default>(v: &mut Vec<T>, n: usize) {
-    v.clear();
-    v.resize(n, T::default());
 }
 
 #[inline]
@@ -279,7 +268,7 @@ impl Wavefront {
         self.generate(scene, batch, n, reconstruction);
         self.collect_aovs = aovs.is_some();
         if self.collect_aovs {
-            zeroed(&mut self.first_hits, n);
+            self.first_hits.zeroed(n);
         }
         if scene.settings.max_depth != 0 {
             self.trace_paths(scene, scene.sampler.as_ref());
@@ -333,7 +322,7 @@ impl Wavefront {
         reconstruction: &Reconstruction,
     ) {
         let width = scene.settings.width;
-        fit(&mut self.ids, n);
+        self.ids.fit(n);
         let mut ids = self.ids.iter_mut();
         for y in b.y0..b.y1 {
             for x in b.x0..b.x1 {
@@ -346,12 +335,12 @@ impl Wavefront {
                 }
             }
         }
-        fit(&mut self.film, n);
+        self.film.fit(n);
         scene.sampler.fill_2d(&self.ids, 0, &mut self.film);
         if let Reconstruction::Importance(filter) = reconstruction {
             // The sample's offset from its pixel's centre, drawn from the
             // filter, and its weight f/pdf.
-            fit(&mut self.filter_weight, n);
+            self.filter_weight.fit(n);
             for (f, w) in self.film.iter_mut().zip(&mut self.filter_weight) {
                 let (offset, weight) = filter.sample(*f);
                 *f = Vec2::splat(0.5) + offset;
@@ -386,9 +375,9 @@ impl Wavefront {
         raster: &[Vec2],
     ) -> &[Rgb] {
         let n = ids.len().min(raster.len());
-        fit(&mut self.ids, n);
+        self.ids.fit(n);
         self.ids.copy_from_slice(&ids[..n]);
-        fit(&mut self.film, n);
+        self.film.fit(n);
         self.film.copy_from_slice(&raster[..n]);
         self.collect_aovs = false;
         self.start_paths(scene, sampler, n);
@@ -401,13 +390,13 @@ impl Wavefront {
     /// Starts the camera paths of `self.ids` at the raster positions
     /// `self.film`: lens samples, rays, shutter times, path state.
     fn start_paths(&mut self, scene: &RenderScene, sampler: &dyn Sampler, n: usize) {
-        fit(&mut self.u2, n);
+        self.u2.fit(n);
         if scene.camera.uses_lens_samples() {
             sampler.fill_2d(&self.ids, 2, &mut self.u2);
         }
-        fit(&mut self.origin, n);
-        fit(&mut self.dir, n);
-        fit(&mut self.u1, n);
+        self.origin.fit(n);
+        self.dir.fit(n);
+        self.u1.fit(n);
         scene.camera.generate(
             &self.film,
             &self.u2,
@@ -419,33 +408,24 @@ impl Wavefront {
         );
         if scene.motion_blur() {
             // Each path lives at one time of the shutter (a box shutter).
-            fit(&mut self.time, n);
+            self.time.fit(n);
             sampler.fill_1d(&self.ids, CAMERA_DIMS, &mut self.time);
             if let Some(motion) = &scene.camera_motion {
                 move_camera_rays(motion, &self.time, &mut self.origin, &mut self.dir);
             }
         }
-        fit(&mut self.beta, n);
+        self.beta.fit(n);
         for (b, w) in self.beta.iter_mut().zip(&self.u1) {
             *b = Rgb::splat(*w);
         }
-        fit(&mut self.eta_scale, n);
+        self.eta_scale.fit(n);
         self.eta_scale.fill(1.0);
-        zeroed(&mut self.radiance, n);
-        fit(&mut self.prev_pdf, n);
-        fit(&mut self.hit, n);
-        self.its.resize(
-            n,
-            Interaction {
-                p: Vec3::ZERO,
-                err: Vec3::ZERO,
-                ng: Vec3::Z,
-                frame: radiant_core::Frame::from_normal(Vec3::Z),
-                uv: Vec2::ZERO,
-            },
-        );
+        self.radiance.zeroed(n);
+        self.prev_pdf.fit(n);
+        self.hit.fit(n);
+        self.its.fit(n);
         if scene.effects.contains(Effects::TANGENT_FRAMES) {
-            fit(&mut self.derivs, n);
+            self.derivs.fit(n);
         }
         self.live.clear();
         self.live.extend(0..n as u32);
@@ -582,9 +562,9 @@ impl Wavefront {
     /// resolves hits, adds emission.
     fn resolve_hits(&mut self, scene: &RenderScene, depth: u32, has_area: bool, has_env: bool) {
         let n = self.live.len();
-        fit(&mut self.next_live, n);
-        fit(&mut self.em_slots, n);
-        fit(&mut self.esc_slots, if has_env { n } else { 0 });
+        self.next_live.resize(n, 0);
+        self.em_slots.resize(n, 0);
+        self.esc_slots.fit(if has_env { n } else { 0 });
         // Slices taken once (bounds in registers); slots written by count.
         let (live, hits) = (&self.live[..], &self.hit[..]);
         let (origin, dir, its) = (&self.origin[..], &self.dir[..], &mut self.its[..]);
@@ -647,8 +627,8 @@ impl Wavefront {
             nlights,
             |slot| surfaces.emitter[hits[slot as usize].prim as usize],
         );
-        fit(&mut self.em_hits, self.em_slots.len());
-        fit(&mut self.em_evals, self.em_slots.len());
+        self.em_hits.fit(self.em_slots.len());
+        self.em_evals.fit(self.em_slots.len());
         let has_media = medium::active(scene);
         for (k, &slot) in self.em_slots.iter().enumerate() {
             let i = slot as usize;
@@ -674,9 +654,9 @@ impl Wavefront {
             }
         }
         let m = self.em_slots.len();
-        fit(&mut self.points, m);
-        fit(&mut self.em_light, m);
-        fit(&mut self.em_pmf, m);
+        self.points.fit(m);
+        self.em_light.fit(m);
+        self.em_pmf.fit(m);
         for light in 0..nlights {
             let (a, b) = (self.offsets[light], self.offsets[light + 1]);
             self.em_light[a as usize..b as usize].fill(light as u32);
@@ -701,8 +681,8 @@ impl Wavefront {
         if n == 0 {
             return;
         }
-        fit(&mut self.esc_dirs, n);
-        fit(&mut self.esc_evals, n);
+        self.esc_dirs.fit(n);
+        self.esc_evals.fit(n);
         for (d, &slot) in self.esc_dirs.iter_mut().zip(&self.esc_slots) {
             *d = self.dir[slot as usize].normalize();
         }
@@ -747,9 +727,9 @@ impl Wavefront {
             );
         }
         let n = self.live.len();
-        fit(&mut self.ids_k, n);
-        fit(&mut self.wo, n);
-        fit(&mut self.uv, n);
+        self.ids_k.fit(n);
+        self.wo.fit(n);
+        self.uv.fit(n);
         let (ids, its, dir) = (&self.ids[..], &self.its[..], &self.dir[..]);
         let outputs = self.ids_k.iter_mut().zip(&mut self.wo).zip(&mut self.uv);
         for (((id, wo), uv), &slot) in outputs.zip(&self.live) {
@@ -759,8 +739,8 @@ impl Wavefront {
             *uv = its[i].uv;
         }
         if scene.effects.contains(Effects::TANGENT_FRAMES) {
-            fit(&mut self.dp_du, n);
-            fit(&mut self.dp_dv, n);
+            self.dp_du.fit(n);
+            self.dp_dv.fit(n);
             let derivs = &self.derivs[..];
             let outputs = self.dp_du.iter_mut().zip(&mut self.dp_dv);
             for ((du, dv), &slot) in outputs.zip(&self.live) {
@@ -777,7 +757,7 @@ impl Wavefront {
     /// paths after [`Wavefront::sort_by_material`] at depth 0): one
     /// `Shader::albedo` call per material.
     fn record_first_hits(&mut self, scene: &RenderScene, n: usize) {
-        fit(&mut self.albedo_k, n);
+        self.albedo_k.fit(n);
         let mut ctx = ShadeContext::new(&scene.textures);
         for (shader, k) in material_ranges(&scene.shaders, &self.offsets) {
             let (a, b) = (k.start, k.end);
@@ -802,20 +782,20 @@ impl Wavefront {
     /// Chooses a light per path and samples a point on it, one module call
     /// per light.
     fn sample_lights(&mut self, scene: &RenderScene, sampler: &dyn Sampler, n: usize, base: u32) {
-        fit(&mut self.u2, n);
+        self.u2.fit(n);
         // Points on lights, where a light reads them: a point or spot
         // light has nothing to choose.
         if scene.lights.uses_point_samples() {
             sampler.fill_2d(&self.ids_k, base + 1, &mut self.u2);
         }
-        fit(&mut self.light, n);
-        fit(&mut self.light_prob, n);
-        fit(&mut self.light_sample, n);
+        self.light.fit(n);
+        self.light_prob.fit(n);
+        self.light_sample.fit(n);
         if let [light] = scene.lights.lights() {
             // One light: no choice to make and no grouping.
             self.light.fill(0);
             self.light_prob.fill(1.0);
-            fit(&mut self.refs, n);
+            self.refs.fit(n);
             let its = &self.its[..];
             for (r, &slot) in self.refs.iter_mut().zip(&self.live) {
                 *r = its[slot as usize].p;
@@ -825,8 +805,8 @@ impl Wavefront {
             self.sample_chosen_lights(scene, sampler, n, base);
         }
         // Directions towards the light samples, in the local frames.
-        fit(&mut self.nee_wi, n);
-        fit(&mut self.nee_wi_world, n);
+        self.nee_wi.fit(n);
+        self.nee_wi_world.fit(n);
         let its = &self.its[..];
         let outputs = self.nee_wi_world.iter_mut().zip(&mut self.nee_wi);
         for ((world, local), (&slot, ls)) in outputs.zip(self.live.iter().zip(&self.light_sample)) {
@@ -846,9 +826,9 @@ impl Wavefront {
         n: usize,
         base: u32,
     ) {
-        fit(&mut self.u1, n);
+        self.u1.fit(n);
         sampler.fill_1d(&self.ids_k, base, &mut self.u1);
-        fit(&mut self.points, n);
+        self.points.fit(n);
         let its = &self.its[..];
         for (p, &slot) in self.points.iter_mut().zip(&self.live) {
             *p = its[slot as usize].p;
@@ -869,9 +849,9 @@ impl Wavefront {
             scene.lights.len(),
             |k| lights[k as usize],
         );
-        fit(&mut self.refs, n);
-        fit(&mut self.light_u, n);
-        fit(&mut self.light_out, n);
+        self.refs.fit(n);
+        self.light_u.fit(n);
+        self.light_out.fit(n);
         for (j, &k) in self.by_light.iter().enumerate() {
             let k = k as usize;
             self.refs[j] = self.points[k];
@@ -896,9 +876,9 @@ impl Wavefront {
     /// continuation, and evaluations towards the light samples.
     fn shade(&mut self, scene: &RenderScene, sampler: &dyn Sampler, base: u32) {
         let n = self.live.len();
-        fit(&mut self.u3, n);
-        fit(&mut self.u1, n);
-        fit(&mut self.u2, n);
+        self.u3.fit(n);
+        self.u1.fit(n);
+        self.u2.fit(n);
         sampler.fill_2d(&self.ids_k, base + 4, &mut self.u2);
         // Lobe choices only for the materials that have lobes to choose.
         for (shader, k) in material_ranges(&scene.shaders, &self.offsets) {
@@ -909,8 +889,8 @@ impl Wavefront {
         for ((u3, &u1), u2) in self.u3.iter_mut().zip(&self.u1).zip(&self.u2) {
             *u3 = Vec3::new(u1, u2.x, u2.y);
         }
-        fit(&mut self.bsdf, n);
-        fit(&mut self.nee_eval, n);
+        self.bsdf.fit(n);
+        self.nee_eval.fit(n);
         // A material's `sample` and `eval` look up its textures at the same
         // coordinates: the second lookup reuses the first's values.
         let mut ctx = ShadeContext::new(&scene.textures).with_stable_uv(&self.uv);
@@ -934,10 +914,10 @@ impl Wavefront {
 
     /// Weights the light samples and traces their shadow rays.
     fn next_event(&mut self, scene: &RenderScene, n: usize) {
-        fit(&mut self.shadow_slot, n);
-        fit(&mut self.shadow_origin, n);
-        fit(&mut self.shadow_dir, n);
-        fit(&mut self.shadow_value, n);
+        self.shadow_slot.fit(n);
+        self.shadow_origin.fit(n);
+        self.shadow_dir.fit(n);
+        self.shadow_value.fit(n);
         // Slices taken once, so that the loop keeps their bounds in
         // registers, and shadow rays written by count rather than pushed.
         let (light_sample, nee_eval, live) = (
@@ -993,7 +973,7 @@ impl Wavefront {
         self.shadow_origin.truncate(m);
         self.shadow_dir.truncate(m);
         self.shadow_value.truncate(m);
-        fit(&mut self.shadow_blocked, self.shadow_slot.len());
+        self.shadow_blocked.fit(self.shadow_slot.len());
         let times = if scene.motion_blur() {
             self.shadow_time.clear();
             let time = &self.time;
@@ -1049,14 +1029,14 @@ impl Wavefront {
         let n = self.live.len();
         let rr_depth = scene.settings.rr_depth;
         let rr_all = depth + 1 >= rr_depth;
-        fit(&mut self.u1, n);
+        self.u1.fit(n);
         if rr_all || per_path {
             // Russian roulette's samples; before `rr_depth` nothing reads
             // them.
             sampler.fill_1d(&self.ids_k, base + 6, &mut self.u1);
         }
         let depths = per_path.then(|| self.media.depth());
-        fit(&mut self.next_live, n);
+        self.next_live.resize(n, 0);
         // Slices taken once (bounds in registers); survivors written by
         // count.
         let (bsdf, live, u) = (&self.bsdf[..n], &self.live[..n], &self.u1[..n]);

@@ -41,6 +41,20 @@ pub struct Interaction {
     pub uv: Vec2,
 }
 
+impl Default for Interaction {
+    /// A hit at the origin facing +z (what a missed ray's slot holds until
+    /// a hit is resolved there).
+    fn default() -> Self {
+        Self {
+            p: Vec3::ZERO,
+            err: Vec3::ZERO,
+            ng: Vec3::Z,
+            frame: Frame::from_normal(Vec3::Z),
+            uv: Vec2::ZERO,
+        }
+    }
+}
+
 /// The surface's derivatives at a hit, in render space with their real
 /// lengths (scene units per unit of u or v).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
