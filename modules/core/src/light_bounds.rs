@@ -276,6 +276,11 @@ impl BoundsLanes {
         let (tx, ty, tz) = (p[0] - cx, p[1] - cy, p[2] - cz);
         let dist2 = tx * tx + ty * ty + tz * tz;
         let d2 = dist2.max(self.half_diagonal);
+        if self.isotropic_point.all() {
+            // Point lights in every lane (one light at four points): the
+            // last select below, without the angular bounds it discards.
+            return Vec4::select(d2.cmple(zero), zero, self.phi * (one / d2));
+        }
         let inside = [0, 1, 2].iter().fold(BVec4A::splat(true), |acc, &k| {
             acc & p[k].cmpge(self.min[k]) & p[k].cmple(self.max[k])
         });
