@@ -381,16 +381,17 @@ impl TileFilm {
         let w = table.factor4(g, x0, pos.x).to_array();
         let gy = table.factor4(g, y0, pos.y).to_array();
         let width = self.bounds.width as usize;
-        let mut start = self.bounds.index(x0, y0);
-        for g in gy {
+        let start = self.bounds.index(x0, y0);
+        // The bounds checked once for the whole footprint, not per row.
+        let footprint = &mut self.current[start..start + 3 * width + 4];
+        for (r, g) in gy.into_iter().enumerate() {
             let vy = v * g;
-            let row: &mut [Vec4; 4] = (&mut self.current[start..start + 4])
-                .try_into()
-                .expect("a slice of four pixels");
+            // SAFETY: r·width + 4 ≤ 3·width + 4, the footprint's length,
+            // for the rows r ≤ 3.
+            let row = unsafe { footprint.get_unchecked_mut(r * width..r * width + 4) };
             for (sum, w) in row.iter_mut().zip(w) {
                 *sum += vy * w;
             }
-            start += width;
         }
     }
 
