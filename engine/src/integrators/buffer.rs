@@ -7,7 +7,7 @@
 //! batch grows them back to a thousand. A `Vec` shrunk by `truncate` and
 //! grown by `resize` writes a default into every element it grows by,
 //! although each stage overwrites the elements it uses: about 300 KB of
-//! stores per batch, 2.5 % of the instructions of a render of
+//! stores per batch, 2.3 % of the instructions of a render of
 //! `scenes/bench/spot-point.yaml`. A [`Buffer`] keeps every element it
 //! ever held, so that shrinking and growing back writes nothing.
 
