@@ -219,7 +219,7 @@ impl InstructionSet {
 
     /// The best level this CPU supports within the limit of
     /// [`limit_instruction_set`].
-    fn detected() -> InstructionSet {
+    pub fn detected() -> InstructionSet {
         let widest = match WIDEST.load(Ordering::Relaxed) {
             0 => InstructionSet::Baseline,
             1 => InstructionSet::Avx2,

@@ -60,6 +60,53 @@ impl Sums {
         }
     }
 
+    /// [`Sums::add_f32`] with AVX-512 (F, DQ and VL): the four channels
+    /// converted side by side and the four 128-bit sums added in one
+    /// 512-bit register, to the same integers.
+    ///
+    /// # Safety
+    ///
+    /// The CPU must have AVX-512 F, DQ and VL.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512vl")]
+    #[inline]
+    pub fn add_f32_avx512(&mut self, v: Vec4) {
+        use std::arch::x86_64::*;
+        let x = _mm256_cvtps_pd(v.into());
+        // `clamp`'s bounds (NaN passes through both, as it does `clamp`),
+        // then `fixed`'s two truncations; NaN lanes give 0, as `as` does.
+        let ordered = _mm256_cmp_pd_mask::<_CMP_ORD_Q>(x, x);
+        let v = _mm256_min_pd(
+            _mm256_set1_pd(LIMIT),
+            _mm256_max_pd(_mm256_set1_pd(-LIMIT), x),
+        );
+        let whole = _mm256_maskz_cvttpd_epi64(ordered, v);
+        let fraction = _mm256_sub_pd(v, _mm256_cvtepi64_pd(whole));
+        let low =
+            _mm256_maskz_cvttpd_epi64(ordered, _mm256_mul_pd(fraction, _mm256_set1_pd(SCALE)));
+        // (whole << 63) + low in 128 bits: the low and high words.
+        let lo_whole = _mm256_slli_epi64::<63>(whole);
+        let lo = _mm256_add_epi64(lo_whole, low);
+        let carry = _mm256_cmplt_epu64_mask(lo, lo_whole);
+        let hi = _mm256_add_epi64(_mm256_srai_epi64::<1>(whole), _mm256_srai_epi64::<63>(low));
+        let hi = _mm256_mask_sub_epi64(hi, carry, hi, _mm256_set1_epi64x(-1));
+        // Interleaved as the sums lie in memory (little-endian i128: low
+        // word first), added, and the low words' carries into the high.
+        let addend = _mm512_permutex2var_epi64(
+            _mm512_castsi256_si512(lo),
+            _mm512_setr_epi64(0, 8, 1, 9, 2, 10, 3, 11),
+            _mm512_castsi256_si512(hi),
+        );
+        let at = self.0.as_mut_ptr().cast::<__m512i>();
+        // SAFETY: the four i128 are 64 contiguous bytes.
+        let old = unsafe { _mm512_loadu_si512(at) };
+        let new = _mm512_add_epi64(old, addend);
+        let carries = _mm512_cmplt_epu64_mask(new, old) & 0b0101_0101;
+        let new = _mm512_mask_sub_epi64(new, carries << 1, new, _mm512_set1_epi64(-1));
+        // SAFETY: as above.
+        unsafe { _mm512_storeu_si512(at, new) };
+    }
+
     /// Adds `other`'s sums.
     #[inline]
     pub fn add(&mut self, other: &Self) {
@@ -161,6 +208,57 @@ mod tests {
         assert_eq!(fixed(f32::NAN), 0);
         // Subnormals truncate to zero.
         assert_eq!(fixed(f32::MIN_POSITIVE / 4.0), 0);
+    }
+
+    #[test]
+    fn avx512_conversion_adds_the_same_integers() {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if !(is_x86_feature_detected!("avx512f")
+                && is_x86_feature_detected!("avx512dq")
+                && is_x86_feature_detected!("avx512vl"))
+            {
+                eprintln!("no AVX-512 DQ: the scalar conversion is the only one");
+                return;
+            }
+            let mut values = vec![
+                0.0f32,
+                -0.0,
+                1.0,
+                -1.0,
+                0.5,
+                -1e-6,
+                3.25e9,
+                1e-12,
+                -1e-30,
+                2e12,
+                -2e12,
+                f32::MAX,
+                -f32::MAX,
+                f32::INFINITY,
+                f32::NEG_INFINITY,
+                f32::NAN,
+                f32::MIN_POSITIVE / 4.0,
+            ];
+            values.extend((1..4000).map(|i| (i as f32 * 0.7731).sin() * 10f32.powi(i % 27 - 13)));
+            // Starting sums near every carry: low words about to wrap,
+            // high words of both signs.
+            let starts = [
+                Sums::ZERO,
+                Sums([i128::MAX, i128::MIN, -1, 1]),
+                Sums([(1 << 64) - 1, -(1 << 64), (1 << 63) - 1, -(1 << 63)]),
+                Sums([u64::MAX as i128, -(u64::MAX as i128), 12345, -67890]),
+            ];
+            for (k, chunk) in values.chunks(4).enumerate() {
+                let v = Vec4::from_array(std::array::from_fn(|j| chunk[j % chunk.len()]));
+                let start = starts[k % starts.len()];
+                let (mut scalar, mut wide) = (start, start);
+                scalar.add_f32(v);
+                // SAFETY: the CPU has AVX-512 F, DQ and VL (checked above).
+                unsafe { wide.add_f32_avx512(v) };
+                assert_eq!(wide, scalar, "{v} onto {start:?}");
+            }
+        }
     }
 
     #[test]

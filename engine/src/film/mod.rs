@@ -28,6 +28,7 @@ pub mod sheet;
 mod tile;
 pub mod tonemap;
 
+use crate::accel::InstructionSet;
 use crate::settings::FilterSampling;
 use exact::Sums;
 use glam::{Vec2, Vec4};
@@ -258,11 +259,42 @@ pub struct TileFilm {
     sums: Vec<Sums>,
     /// Samples whose value was NaN or infinite (recorded as zero).
     pub invalid_samples: u64,
+    /// Whether [`TileFilm::end_block`] converts with AVX-512
+    /// ([`Sums::add_f32_avx512`]): where the CPU has F, DQ and VL and
+    /// `--max-isa` allows AVX-512.
+    wide_sums: bool,
     /// The weight of the samples added next, value and filter weight both
     /// (1 unless set): under adaptive sampling 1 / the samples their pixel
     /// takes, so that every pixel weighs as much in a splat neighbourhood
     /// however many samples it took.
     scale: f32,
+}
+
+/// Whether tiles end their blocks with AVX-512 ([`Sums::add_f32_avx512`]):
+/// the CPU has F, DQ and VL, and the instruction sets in use
+/// ([`InstructionSet::detected`], which `--max-isa` limits) reach AVX-512.
+fn wide_sums() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        InstructionSet::detected() == InstructionSet::Avx512
+            && std::arch::is_x86_feature_detected!("avx512dq")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// [`TileFilm::end_block`]'s loop with [`Sums::add_f32_avx512`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512vl")]
+fn end_block_avx512(sums: &mut [Sums], current: &mut [Vec4]) {
+    for (sum, current) in sums.iter_mut().zip(current) {
+        if *current != Vec4::ZERO {
+            sum.add_f32_avx512(*current);
+            *current = Vec4::ZERO;
+        }
+    }
 }
 
 impl TileFilm {
@@ -275,6 +307,7 @@ impl TileFilm {
             current: vec![Vec4::ZERO; bounds.len()],
             sums: vec![Sums::ZERO; bounds.len()],
             invalid_samples: 0,
+            wide_sums: wide_sums(),
             scale: 1.0,
         }
     }
@@ -308,6 +341,13 @@ impl TileFilm {
     /// pixels in order, between calls, so the exact sums do not depend on
     /// how the samples were cut into batches.
     pub fn end_block(&mut self) {
+        #[cfg(target_arch = "x86_64")]
+        if self.wide_sums {
+            // SAFETY: `wide_sums` only where the CPU has AVX-512 F, DQ and
+            // VL (`wide_sums()`).
+            unsafe { end_block_avx512(&mut self.sums, &mut self.current) };
+            return;
+        }
         for (sum, current) in self.sums.iter_mut().zip(&mut self.current) {
             if *current != Vec4::ZERO {
                 sum.add_f32(*current);
