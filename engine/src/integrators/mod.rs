@@ -22,6 +22,7 @@ mod medium;
 pub mod mlt;
 pub mod module;
 pub mod path;
+mod shading_order;
 mod sort;
 pub mod splat;
 pub mod strategies;

@@ -20,6 +20,7 @@
 
 use super::buffer::Buffer;
 use super::medium::{self, MEDIUM_DIMS, MediumState};
+use super::shading_order::ShadingOrder;
 use super::sort::sort_by_key;
 use super::surface::{
     self, Derivatives, Interaction, PREFETCH_AHEAD, interaction, interaction_with_derivatives,
@@ -96,6 +97,9 @@ pub struct Wavefront {
     scratch: Vec<u32>,
     cursor: Vec<u32>,
     offsets: Vec<u32>,
+    /// The order of the material groups `offsets` delimits: those that
+    /// take light samples first.
+    shading: ShadingOrder,
     // Per live path in material order (index k).
     ids_k: Buffer<SampleId>,
     wo: Buffer<Vec3>,
@@ -209,16 +213,17 @@ fn surface_batch<'a>(
     }
 }
 
-/// Each shader with the range of live paths (material order, as
+/// Each shader with the range of live paths (in `order`, as
 /// [`sort_by_key`] leaves them with `offsets`) that it shades, where that
 /// range is not empty.
 fn material_ranges<'a>(
     shaders: &'a [Box<dyn Shader>],
+    order: &'a ShadingOrder,
     offsets: &'a [u32],
 ) -> impl Iterator<Item = (&'a dyn Shader, std::ops::Range<usize>)> + 'a {
-    shaders.iter().enumerate().filter_map(|(m, shader)| {
-        let (a, b) = (offsets[m] as usize, offsets[m + 1] as usize);
-        (a < b).then(|| (shader.as_ref(), a..b))
+    (0..shaders.len()).filter_map(move |r| {
+        let (a, b) = (offsets[r] as usize, offsets[r + 1] as usize);
+        (a < b).then(|| (shaders[order.material(r)].as_ref(), a..b))
     })
 }
 
@@ -447,6 +452,7 @@ impl Wavefront {
         if has_media {
             self.media.start(scene, &self.origin[..self.live.len()]);
         }
+        self.shading.update(&scene.shaders);
         // Segments traced so far: every path's depth where there are no
         // `null` boundaries; with them each path keeps its own depth
         // (`MediumState::depth`).
@@ -476,8 +482,15 @@ impl Wavefront {
             let Some(n) = self.select_vertices(scene, depth, max_depth, has_media) else {
                 break;
             };
+            // The paths that take light samples: a prefix of the `n` sorted
+            // ones (all of them where media add their phase groups last).
+            let lit = if has_media {
+                n
+            } else {
+                self.shading.lit_paths(&self.offsets)
+            };
             if has_lights {
-                self.sample_lights(scene, sampler, n, base);
+                self.sample_lights(scene, sampler, lit, base);
             }
             self.shade(scene, sampler, base);
             if has_media {
@@ -492,7 +505,7 @@ impl Wavefront {
                 );
             }
             if has_lights {
-                self.next_event(scene, n);
+                self.next_event(scene, lit);
             }
             self.continue_paths(scene, sampler, depth, has_media, base);
             if has_media {
@@ -699,7 +712,7 @@ impl Wavefront {
 
     /// Sorts live paths by material and gathers their shading inputs.
     fn sort_by_material(&mut self, scene: &RenderScene) -> usize {
-        let hits = &self.hit;
+        let (hits, order) = (&self.hit, &self.shading);
         let materials = scene.shaders.len();
         if medium::active(scene) {
             // Medium events after the materials, one group per medium.
@@ -713,7 +726,7 @@ impl Wavefront {
                 |slot| {
                     media
                         .event_group(slot, materials)
-                        .unwrap_or_else(|| scene.material(&hits[slot as usize]))
+                        .unwrap_or_else(|| order.rank(scene.material(&hits[slot as usize])))
                 },
             );
         } else {
@@ -723,7 +736,7 @@ impl Wavefront {
                 &mut self.cursor,
                 &mut self.offsets,
                 materials,
-                |slot| scene.material(&hits[slot as usize]),
+                |slot| order.rank(scene.material(&hits[slot as usize])),
             );
         }
         let n = self.live.len();
@@ -759,7 +772,7 @@ impl Wavefront {
     fn record_first_hits(&mut self, scene: &RenderScene, n: usize) {
         self.albedo_k.fit(n);
         let mut ctx = ShadeContext::new(&scene.textures);
-        for (shader, k) in material_ranges(&scene.shaders, &self.offsets) {
+        for (shader, k) in material_ranges(&scene.shaders, &self.shading, &self.offsets) {
             let (a, b) = (k.start, k.end);
             let surface = surface_batch(shader, [&self.wo, &self.dp_du, &self.dp_dv], &self.uv, k);
             shader.albedo(&mut ctx, surface, &mut self.albedo_k[a..b]);
@@ -779,14 +792,14 @@ impl Wavefront {
         }
     }
 
-    /// Chooses a light per path and samples a point on it, one module call
-    /// per light.
+    /// Chooses a light for each of the first `n` sorted paths and samples a
+    /// point on it, one module call per light.
     fn sample_lights(&mut self, scene: &RenderScene, sampler: &dyn Sampler, n: usize, base: u32) {
         self.u2.fit(n);
         // Points on lights, where a light reads them: a point or spot
         // light has nothing to choose.
         if scene.lights.uses_point_samples() {
-            sampler.fill_2d(&self.ids_k, base + 1, &mut self.u2);
+            sampler.fill_2d(&self.ids_k[..n], base + 1, &mut self.u2);
         }
         self.light.fit(n);
         self.light_prob.fit(n);
@@ -827,7 +840,7 @@ impl Wavefront {
         base: u32,
     ) {
         self.u1.fit(n);
-        sampler.fill_1d(&self.ids_k, base, &mut self.u1);
+        sampler.fill_1d(&self.ids_k[..n], base, &mut self.u1);
         self.points.fit(n);
         let its = &self.its[..];
         for (p, &slot) in self.points.iter_mut().zip(&self.live) {
@@ -881,7 +894,7 @@ impl Wavefront {
         self.u2.fit(n);
         sampler.fill_2d(&self.ids_k, base + 4, &mut self.u2);
         // Lobe choices only for the materials that have lobes to choose.
-        for (shader, k) in material_ranges(&scene.shaders, &self.offsets) {
+        for (shader, k) in material_ranges(&scene.shaders, &self.shading, &self.offsets) {
             if shader.uses_lobe_samples() {
                 sampler.fill_1d(&self.ids_k[k.clone()], base + 3, &mut self.u1[k]);
             }
@@ -895,7 +908,7 @@ impl Wavefront {
         // coordinates: the second lookup reuses the first's values.
         let mut ctx = ShadeContext::new(&scene.textures).with_stable_uv(&self.uv);
         let has_lights = !scene.lights.is_empty();
-        for (shader, k) in material_ranges(&scene.shaders, &self.offsets) {
+        for (shader, k) in material_ranges(&scene.shaders, &self.shading, &self.offsets) {
             let (a, b) = (k.start, k.end);
             let surface = surface_batch(shader, [&self.wo, &self.dp_du, &self.dp_dv], &self.uv, k);
             shader.sample(&mut ctx, surface, &self.u3[a..b], &mut self.bsdf[a..b]);
@@ -912,7 +925,8 @@ impl Wavefront {
         }
     }
 
-    /// Weights the light samples and traces their shadow rays.
+    /// Weights the light samples of the first `n` sorted paths and traces
+    /// their shadow rays.
     fn next_event(&mut self, scene: &RenderScene, n: usize) {
         self.shadow_slot.fit(n);
         self.shadow_origin.fit(n);
