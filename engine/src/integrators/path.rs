@@ -729,6 +729,17 @@ impl Wavefront {
                         .unwrap_or_else(|| order.rank(scene.material(&hits[slot as usize])))
                 },
             );
+        } else if order.is_identity() {
+            // No purely specular material before one with smooth lobes:
+            // the materials are their own ranks, unlooked-up.
+            sort_by_key(
+                &mut self.live,
+                &mut self.scratch,
+                &mut self.cursor,
+                &mut self.offsets,
+                materials,
+                |slot| scene.material(&hits[slot as usize]),
+            );
         } else {
             sort_by_key(
                 &mut self.live,

@@ -22,6 +22,9 @@ pub(super) struct ShadingOrder {
     material: Vec<u32>,
     /// How many ranks have smooth lobes (the ranks before this).
     lit: usize,
+    /// Whether every material's rank is its number (no purely specular
+    /// material comes before one with smooth lobes).
+    identity: bool,
 }
 
 impl ShadingOrder {
@@ -41,6 +44,13 @@ impl ShadingOrder {
         for (r, &m) in self.material.iter().enumerate() {
             self.rank[m as usize] = r as u32;
         }
+        self.identity = self.rank.iter().enumerate().all(|(m, &r)| r as usize == m);
+    }
+
+    /// Whether every material is its own rank, so that a sort may key
+    /// paths by material without [`Self::rank`].
+    pub(super) fn is_identity(&self) -> bool {
+        self.identity
     }
 
     /// The sort key of material `material`.
@@ -105,6 +115,7 @@ mod tests {
         order.update(&shaders);
         assert_eq!(order.material, [1, 3, 0, 2]);
         assert_eq!(order.lit, 2);
+        assert!(!order.is_identity());
         for m in 0..4 {
             assert_eq!(order.material(order.rank(m as u32) as usize), m);
         }
@@ -113,5 +124,9 @@ mod tests {
         // Again with fewer materials: the buffers shrink with them.
         order.update(&shaders[..1]);
         assert_eq!((order.material.as_slice(), order.lit), ([0].as_slice(), 0));
+        assert!(order.is_identity());
+        // Smooth materials already first: every material is its own rank.
+        order.update(&shaders[1..3]);
+        assert!(order.is_identity() && order.lit == 1);
     }
 }
