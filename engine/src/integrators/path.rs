@@ -714,41 +714,25 @@ impl Wavefront {
     fn sort_by_material(&mut self, scene: &RenderScene) -> usize {
         let (hits, order) = (&self.hit, &self.shading);
         let materials = scene.shaders.len();
+        let material = |slot: u32| scene.material(&hits[slot as usize]);
+        let (live, scratch) = (&mut self.live, &mut self.scratch);
+        let (cursor, offsets) = (&mut self.cursor, &mut self.offsets);
         if medium::active(scene) {
             // Medium events after the materials, one group per medium.
             let media = &self.media;
-            sort_by_key(
-                &mut self.live,
-                &mut self.scratch,
-                &mut self.cursor,
-                &mut self.offsets,
-                materials + scene.media.phases.len(),
-                |slot| {
-                    media
-                        .event_group(slot, materials)
-                        .unwrap_or_else(|| order.rank(scene.material(&hits[slot as usize])))
-                },
-            );
+            let groups = materials + scene.media.phases.len();
+            sort_by_key(live, scratch, cursor, offsets, groups, |slot| {
+                media
+                    .event_group(slot, materials)
+                    .unwrap_or_else(|| order.rank(material(slot)))
+            });
         } else if order.is_identity() {
             // No purely specular material before one with smooth lobes:
             // the materials are their own ranks, unlooked-up.
-            sort_by_key(
-                &mut self.live,
-                &mut self.scratch,
-                &mut self.cursor,
-                &mut self.offsets,
-                materials,
-                |slot| scene.material(&hits[slot as usize]),
-            );
+            sort_by_key(live, scratch, cursor, offsets, materials, material);
         } else {
-            sort_by_key(
-                &mut self.live,
-                &mut self.scratch,
-                &mut self.cursor,
-                &mut self.offsets,
-                materials,
-                |slot| order.rank(scene.material(&hits[slot as usize])),
-            );
+            let rank = |slot| order.rank(material(slot));
+            sort_by_key(live, scratch, cursor, offsets, materials, rank);
         }
         let n = self.live.len();
         self.ids_k.fit(n);
