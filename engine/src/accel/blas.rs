@@ -576,6 +576,26 @@ impl<'a, const MOVING: bool, const SPHERES: bool> Query<'a, MOVING, SPHERES> {
         }
     }
 
+    /// This query set up for `ray` in `blas` as [`Query::new`] would, in
+    /// place: only the fields this kind of level reads are written (a ray
+    /// entering a static level of triangles leaves its origin, direction
+    /// and time unstored).
+    #[inline(always)]
+    fn restart(&mut self, blas: &'a Blas, ray: &Ray) {
+        self.packets = &blas.packets;
+        if MOVING {
+            self.closing = blas.closing.as_ref().map_or(&[][..], |c| &c.packets);
+            self.tau = ray.tau;
+        }
+        if SPHERES {
+            self.origin = ray.origin;
+            self.dir = ray.dir;
+        }
+        self.prep = ray.prep;
+        self.base = 0;
+        self.best = Hit::MISS;
+    }
+
     /// The triangles of packet `i`, `tris`, at the ray's time.
     #[inline(always)]
     fn tris(&self, i: usize, tris: &Tri4) -> Tri4 {

@@ -221,7 +221,7 @@ impl Blas {
         tmax: f32,
     ) {
         let ray = Ray::new::<I>(origin, dir, 0.0);
-        lane.query = self.query::<MOVING, SPHERES>(&ray);
+        lane.query.restart(self, &ray);
         lane.boxes = ray.boxes;
         lane.walk.restart(tmax);
         lane.hit = false;
