@@ -20,7 +20,7 @@
 
 use super::buffer::Buffer;
 use super::medium::{self, MEDIUM_DIMS, MediumState};
-use super::shading_order::ShadingOrder;
+use super::shading_order::{ShadingOrder, reads_light_samples};
 use super::sort::sort_by_key;
 use super::surface::{
     self, Derivatives, Interaction, PREFETCH_AHEAD, interaction, interaction_with_derivatives,
@@ -907,7 +907,7 @@ impl Wavefront {
             let (a, b) = (k.start, k.end);
             let surface = surface_batch(shader, [&self.wo, &self.dp_du, &self.dp_dv], &self.uv, k);
             shader.sample(&mut ctx, surface, &self.u3[a..b], &mut self.bsdf[a..b]);
-            if has_lights && shader.effects().contains(Effects::SMOOTH_LOBES) {
+            if has_lights && reads_light_samples(shader) {
                 shader.eval(
                     &mut ctx,
                     surface,

@@ -12,6 +12,13 @@
 
 use radiant_core::{Effects, Shader};
 
+/// Whether next-event estimation reads `shader`'s light samples: where it
+/// has smooth lobes, whose `eval` towards a light sample can be non-zero.
+#[inline]
+pub(super) fn reads_light_samples(shader: &dyn Shader) -> bool {
+    shader.effects().contains(Effects::SMOOTH_LOBES)
+}
+
 /// A permutation of a scene's materials: those with smooth lobes first (in
 /// material order), then the rest (in material order).
 #[derive(Debug, Default)]
@@ -32,7 +39,7 @@ impl ShadingOrder {
     /// buffers: called once per batch, it allocates only when the scene
     /// has more materials than before.
     pub(super) fn update(&mut self, shaders: &[Box<dyn Shader>]) {
-        let smooth = |m: &usize| shaders[*m].effects().contains(Effects::SMOOTH_LOBES);
+        let smooth = |m: &usize| reads_light_samples(shaders[*m].as_ref());
         self.material.clear();
         self.material
             .extend((0..shaders.len()).filter(smooth).map(|m| m as u32));
